@@ -1,0 +1,318 @@
+// snell's command line: the only place that maps errors to exit statuses.
+//   0 success · 1 runtime failure (Vulkan, files) · 2 bad scene or command line · 130 interrupted
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <thread>
+
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+
+#include "gpu/ComputeRenderer.h"
+#include "image/ImageIO.h"
+#include "metrics/ImageMetrics.h"
+#include "reference/CpuRenderer.h"
+#include "scene/Parser.h"
+#include "vulkan/VulkanContext.h"
+
+#ifndef SNELL_VERSION
+#define SNELL_VERSION "0.0.0"
+#endif
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point start) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+constexpr int kExitRuntime = 1;
+constexpr int kExitInput = 2;
+constexpr int kExitInterrupted = 130;
+constexpr int kMaxGpuDepth = 256;
+
+std::atomic<bool> gInterrupted{false};
+extern "C" void onSignal(int) { gInterrupted.store(true); }
+
+const char* kExitStatuses =
+    "Exit status: 0 success; 1 runtime failure (no Vulkan device, device lost, unwritable output);\n"
+    "2 bad scene file or command line (the message is FILE:LINE:COL: error: ...); 130 interrupted.";
+
+struct RenderOptions {
+    std::string scene;
+    std::string output;
+    bool cpu = false;
+    std::optional<int> size;
+    std::optional<int> depth;
+    std::optional<double> minWeight;
+    std::optional<int> supersample;
+    int gpu = -1;
+    bool stats = false;
+    bool quiet = false;
+    bool validation = false;
+};
+
+std::string jsonString(const std::string& s) {
+    std::string out = "\"";
+    for (char c : s) {
+        if (c == '"' || c == '\\') { out += '\\'; out += c; }
+        else if (static_cast<unsigned char>(c) < 0x20) { char b[8]; std::snprintf(b, sizeof b, "\\u%04x", c); out += b; }
+        else out += c;
+    }
+    return out + "\"";
+}
+
+// A progress line on stderr, only when stderr is a terminal.
+class Progress {
+public:
+    explicit Progress(bool enabled) : enabled_(enabled && ::isatty(STDERR_FILENO)) {}
+    std::function<void(double)> callback() {
+        if (!enabled_) return {};
+        return [this](double fraction) {
+            std::lock_guard<std::mutex> lock(mutex_);
+            const auto now = Clock::now();
+            if (fraction < 1.0 && now - last_ < std::chrono::milliseconds(100)) return;
+            last_ = now;
+            shown_ = true;
+            std::fprintf(stderr, "\rsnell: rendering %5.1f%%", 100.0 * fraction);
+            std::fflush(stderr);
+        };
+    }
+    ~Progress() {
+        if (shown_) std::fprintf(stderr, "\r%*s\r", 40, "");
+    }
+
+private:
+    bool enabled_;
+    bool shown_ = false;
+    std::mutex mutex_;
+    Clock::time_point last_{};
+};
+
+int runRender(const RenderOptions& o) {
+    const auto totalStart = Clock::now();
+    snell::Scene scene;
+    const auto parseStart = Clock::now();
+    try {
+        scene = snell::parseSceneFile(o.scene);
+    } catch (const snell::ParseError& e) {
+        std::cerr << e.what() << "\n";
+        return kExitInput;
+    }
+    const double parseMs = msSince(parseStart);
+    if (!o.quiet)
+        for (const snell::Diagnostic& w : scene.warnings) std::cerr << w.format("warning") << "\n";
+
+    const std::string output = o.output.empty() ? scene.name + ".png" : o.output;
+    try {
+        snell::checkWritable(output);
+    } catch (const snell::ImageIOError& e) {
+        std::cerr << "snell: error: " << e.what() << "\n";
+        return kExitRuntime;
+    }
+
+    snell::RenderRequest request;
+    const int size = o.size.value_or(scene.imageSize);
+    request.width = request.height = size;
+    request.supersample = o.supersample.value_or(scene.supersample);
+    request.camera = snell::Camera::fromSpec(size, scene.halfWidth);
+    request.trace = o.cpu ? snell::kReferenceSettings : snell::kDefaultSettings;
+    if (o.depth) request.trace.maxDepth = *o.depth;
+    if (o.minWeight) request.trace.minWeight = *o.minWeight;
+    request.cancel = &gInterrupted;
+    Progress progress(!o.quiet);
+    request.progress = progress.callback();
+
+    snell::Image image;
+    snell::RayCounts rays;
+    double uploadMs = 0, pipelineMs = 0, renderMs = 0, readbackMs = 0;
+    std::string device, timing;
+    std::size_t trueSpheres = scene.spheres.size() - scene.ellipsoidCount();
+    if (o.cpu) {
+        const auto start = Clock::now();
+        snell::CpuRenderer renderer(scene);
+        image = renderer.render(request, &rays);
+        renderMs = msSince(start);
+        device = "CPU reference (double, " + std::to_string(std::max(1u, std::thread::hardware_concurrency())) + " threads)";
+        timing = "host";
+    } else {
+        if (request.trace.maxDepth > kMaxGpuDepth) {
+            std::cerr << "snell: error: --depth " << request.trace.maxDepth << " exceeds the GPU limit of "
+                      << kMaxGpuDepth << " (use --cpu for deeper trees)\n";
+            return kExitInput;
+        }
+        try {
+            snell::vk::ContextOptions options;
+            options.deviceIndex = o.gpu;
+            options.validation = o.validation;
+            snell::vk::Context context(options);
+            device = context.deviceName();
+            snell::ComputeRenderer renderer(context, scene, request.camera);
+            uploadMs = renderer.uploadMs();
+            snell::GpuRenderResult r = renderer.render(request, o.stats);
+            image = std::move(r.image);
+            rays = r.rays;
+            renderMs = r.renderMs;
+            pipelineMs = r.pipelineMs;
+            readbackMs = r.readbackMs;
+            timing = r.gpuTimed ? "gpu-timestamps" : "host";
+            if (o.validation && context.validationMessages() > 0) {
+                std::cerr << "snell: error: the Vulkan validation layer reported " << context.validationMessages()
+                          << " message(s)\n";
+                return kExitRuntime;
+            }
+        } catch (const snell::vk::VulkanError& e) {
+            if (gInterrupted.load()) {
+                std::cerr << "\nsnell: interrupted; no image written\n";
+                return kExitInterrupted;
+            }
+            std::cerr << "snell: error: " << e.what() << "\n";
+            return kExitRuntime;
+        }
+    }
+    if (gInterrupted.load()) {
+        std::cerr << "\nsnell: interrupted; no image written\n";
+        return kExitInterrupted;
+    }
+    const auto writeStart = Clock::now();
+    try {
+        snell::writeImage(output, image);
+    } catch (const snell::ImageIOError& e) {
+        std::cerr << "snell: error: " << e.what() << "\n";
+        return kExitRuntime;
+    }
+    const double writeMs = msSince(writeStart);
+    if (o.stats) {
+        std::ostringstream j;
+        j.precision(6);
+        j << std::fixed << "{\"scene\": " << jsonString(o.scene) << ", \"output\": " << jsonString(output)
+          << ", \"backend\": \"" << (o.cpu ? "cpu" : "gpu") << "\", \"device\": " << jsonString(device)
+          << ", \"width\": " << request.width << ", \"height\": " << request.height
+          << ", \"supersample\": " << request.supersample << ", \"max_depth\": " << request.trace.maxDepth
+          << ", \"min_weight\": " << request.trace.minWeight << ", \"spheres\": " << scene.spheres.size()
+          << ", \"true_spheres\": " << trueSpheres << ", \"ellipsoids\": " << scene.ellipsoidCount()
+          << ", \"lights\": " << scene.lights.size() << ", \"parse_ms\": " << parseMs
+          << ", \"upload_ms\": " << uploadMs << ", \"pipeline_ms\": " << pipelineMs
+          << ", \"render_ms\": " << renderMs << ", \"render_timing\": \"" << timing << "\""
+          << ", \"readback_ms\": " << readbackMs << ", \"write_ms\": " << writeMs
+          << ", \"total_ms\": " << msSince(totalStart) << ", \"rays\": {\"primary\": " << rays.primary
+          << ", \"shadow\": " << rays.shadow << ", \"reflected\": " << rays.reflected
+          << ", \"refracted\": " << rays.refracted << ", \"total\": " << rays.total() << "}}";
+        std::cout << j.str() << std::endl;
+    }
+    return 0;
+}
+
+int runCompare(const std::string& a, const std::string& b, const std::string& diff, int threshold) {
+    try {
+        const snell::Image test = snell::readImage(a);
+        const snell::Image reference = snell::readImage(b);
+        const snell::ImageMetrics m = snell::compareImages(test, reference, threshold);
+        if (!diff.empty()) snell::writeImage(diff, snell::differenceImage(test, reference));
+        std::cout << m.json() << std::endl;
+    } catch (const std::exception& e) {
+        std::cerr << "snell: error: " << e.what() << "\n";
+        return kExitRuntime;
+    }
+    return 0;
+}
+
+int runDevices() {
+    try {
+        const auto reports = snell::vk::Context::listDevices();
+        if (reports.empty()) {
+            std::cerr << "snell: no Vulkan device found: apt-get install mesa-vulkan-drivers\n";
+            return kExitRuntime;
+        }
+        for (const auto& r : reports)
+            std::cout << r.index << ": " << r.name << " (" << r.type << ", " << r.driver << ")"
+                      << (r.usable ? "" : " — unusable: " + r.reason) << "\n";
+    } catch (const snell::vk::VulkanError& e) {
+        std::cerr << "snell: error: " << e.what() << "\n";
+        return kExitRuntime;
+    }
+    return 0;
+}
+
+std::string versionText() {
+    std::string text = std::string("snell ") + SNELL_VERSION;
+    try {
+        snell::vk::Context context;
+        text += "\ndevice: " + context.deviceName() + " (" + context.driverInfo() + ")";
+    } catch (const snell::vk::VulkanError& e) {
+        text += "\ndevice: none (" + std::string(e.what()) + ")";
+    }
+    return text;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    CLI::App app{"snell: a Whitted-style ray tracer whose renderer is a Vulkan compute shader.\n"
+                 "Scene format: see README.md and SPEC.md."};
+    app.footer(kExitStatuses);
+    app.require_subcommand(0, 1);
+    bool version = false;
+    app.add_flag("--version", version, "Print the version and the Vulkan device snell would use");
+
+    RenderOptions ro;
+    CLI::App* render = app.add_subcommand("render", "Render a scene file to an image (PNG, PPM or PFM by extension)");
+    render->add_option("scene", ro.scene, "Scene file")->required();
+    render->add_option("-o,--output", ro.output, "Output image: .png, .ppm (P6) or .pfm (float); default SCENE.png");
+    render->add_flag("--cpu", ro.cpu, "Render with the double-precision CPU reference instead of the GPU");
+    render->add_option("-s,--size", ro.size, "Image size in pixels (overrides the scene's view n)")
+        ->check(CLI::Range(1, snell::ParseLimits::kMaxImageSize));
+    render->add_option("-d,--depth", ro.depth, "Maximum reflection/refraction depth (default: GPU 32, CPU 64)")
+        ->check(CLI::Range(0, 100000));
+    render->add_option("--min-weight", ro.minWeight, "Stop rays whose weight falls below W; 0 disables (default: GPU 5e-4, CPU 1e-7)")
+        ->check(CLI::Range(0.0, 1.0));
+    render->add_option("--spp,--supersample", ro.supersample, "Rays per pixel per axis (overrides the scene's supersample)")
+        ->check(CLI::Range(1, snell::ParseLimits::kMaxSupersample));
+    render->add_option("--gpu", ro.gpu, "Vulkan device index (see 'snell devices'; default: $SNELL_GPU, else the best)")
+        ->envname("SNELL_GPU")->check(CLI::NonNegativeNumber);
+    render->add_flag("--stats", ro.stats, "Print timings and ray counts as one JSON object on the last line of stdout");
+    render->add_flag("-q,--quiet", ro.quiet, "No warnings or progress on stderr");
+    render->add_flag("--validation", ro.validation, "Enable the Khronos validation layer; any message fails the render")
+        ->envname("SNELL_VALIDATION");
+
+    std::string compareA, compareB, compareDiff;
+    int compareThreshold = 3;
+    CLI::App* compare = app.add_subcommand("compare", "Error metrics of image A against reference B, as JSON (8-bit units)");
+    compare->add_option("a", compareA, "Test image")->required();
+    compare->add_option("b", compareB, "Reference image")->required();
+    compare->add_option("--diff", compareDiff, "Write a false-colour difference image");
+    compare->add_option("--bad-threshold", compareThreshold, "A pixel is bad when a channel differs by more (default 3)");
+
+    app.add_subcommand("devices", "List the Vulkan devices and why any cannot be used");
+
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::CallForHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::CallForAllHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::ParseError& e) {
+        app.exit(e);
+        return kExitInput;
+    }
+    if (version) {
+        std::cout << versionText() << "\n";
+        return 0;
+    }
+    std::signal(SIGINT, onSignal);
+    std::signal(SIGTERM, onSignal);
+    if (render->parsed()) return runRender(ro);
+    if (app.got_subcommand("devices")) return runDevices();
+    if (compare->parsed()) return runCompare(compareA, compareB, compareDiff, compareThreshold);
+    std::cout << app.help();
+    return 0;
+}

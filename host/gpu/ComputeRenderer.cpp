@@ -1,0 +1,336 @@
+#include "gpu/ComputeRenderer.h"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+
+#include "trace_comp_spv.h"  // generated at build time from shaders/trace.comp
+
+namespace snell {
+
+using vk::check;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point start) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+constexpr VkBufferUsageFlags kStorage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+// Primary rays per submission: keeps each submission short on any device.
+constexpr std::uint64_t kRaysPerTile = 1u << 18;
+
+}  // namespace
+
+struct ComputeRenderer::Pipeline {
+    VkDescriptorSetLayout setLayout = VK_NULL_HANDLE;
+    VkPipelineLayout layout = VK_NULL_HANDLE;
+    VkPipeline pipeline = VK_NULL_HANDLE;
+    VkShaderModule module = VK_NULL_HANDLE;
+    VkDescriptorPool pool = VK_NULL_HANDLE;
+    VkDescriptorSet set = VK_NULL_HANDLE;
+    VkQueryPool queries = VK_NULL_HANDLE;
+    VkCommandPool commandPool = VK_NULL_HANDLE;
+    VkCommandBuffer commands = VK_NULL_HANDLE;
+    VkFence fence = VK_NULL_HANDLE;
+    vk::Buffer frame, counters, readback;
+    vk::StorageImage image;
+};
+
+ComputeRenderer::ComputeRenderer(vk::Context& context, const Scene& scene, const Camera& camera)
+    : context_(context), scene_(scene) {
+    const auto start = Clock::now();
+    layout_ = gpu::buildGpuScene(scene, camera);
+    const VkDeviceSize limit = context.properties().limits.maxStorageBufferRange;
+    auto upload = [&](const auto& v, const char* what) {
+        const VkDeviceSize bytes = v.size() * sizeof(v[0]);
+        if (bytes > limit)
+            throw vk::VulkanError(std::string("the scene's ") + what + " need " + std::to_string(bytes >> 20) +
+                                  " MiB, more than this device's storage-buffer limit of " +
+                                  std::to_string(limit >> 20) + " MiB");
+        return context_.createBufferWithData(v.data(), bytes, kStorage);
+    };
+    try {
+        spheres_ = upload(layout_.spheres, "spheres");
+        ellipsoids_ = upload(layout_.ellipsoids, "ellipsoids");
+        materials_ = upload(layout_.materials, "materials");
+        lights_ = upload(layout_.lights, "lights");
+        nodes_ = upload(layout_.nodes, "BVH nodes");
+    } catch (...) {
+        for (vk::Buffer* b : {&spheres_, &ellipsoids_, &materials_, &lights_, &nodes_}) context_.destroy(*b);
+        throw;
+    }
+    uploadMs_ = msSince(start);
+}
+
+ComputeRenderer::~ComputeRenderer() {
+    for (vk::Buffer* b : {&spheres_, &ellipsoids_, &materials_, &lights_, &nodes_}) context_.destroy(*b);
+}
+
+void ComputeRenderer::createPipeline(const RenderRequest& request, bool countRays, Pipeline& p) {
+    VkDevice device = context_.device();
+    std::array<VkDescriptorSetLayoutBinding, 8> bindings{};
+    for (std::uint32_t i = 0; i < bindings.size(); ++i) {
+        bindings[i].binding = i;
+        bindings[i].descriptorCount = 1;
+        bindings[i].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
+        bindings[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    }
+    bindings[SNELL_BINDING_OUTPUT_IMAGE].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
+    bindings[SNELL_BINDING_FRAME].descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
+    VkDescriptorSetLayoutCreateInfo setInfo{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
+    setInfo.bindingCount = static_cast<std::uint32_t>(bindings.size());
+    setInfo.pBindings = bindings.data();
+    check(vkCreateDescriptorSetLayout(device, &setInfo, nullptr, &p.setLayout), "vkCreateDescriptorSetLayout");
+
+    VkPushConstantRange push{VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(gpu::TileParams)};
+    VkPipelineLayoutCreateInfo layoutInfo{VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO};
+    layoutInfo.setLayoutCount = 1;
+    layoutInfo.pSetLayouts = &p.setLayout;
+    layoutInfo.pushConstantRangeCount = 1;
+    layoutInfo.pPushConstantRanges = &push;
+    check(vkCreatePipelineLayout(device, &layoutInfo, nullptr, &p.layout), "vkCreatePipelineLayout");
+
+    VkShaderModuleCreateInfo moduleInfo{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
+    moduleInfo.codeSize = sizeof(snell_trace_comp_spv);
+    moduleInfo.pCode = snell_trace_comp_spv;
+    check(vkCreateShaderModule(device, &moduleInfo, nullptr, &p.module), "vkCreateShaderModule");
+
+    // Specialise to the scene: only what it uses is compiled.
+    const bool hasRefraction = layout_.refractiveSpheres > 0;
+    std::array<std::uint32_t, 9> values{};
+    values[SNELL_SPEC_USE_BVH] = !layout_.nodes.empty();
+    values[SNELL_SPEC_HAS_ELLIPSOIDS] = !layout_.ellipsoids.empty();
+    values[SNELL_SPEC_HAS_REFRACTION] = hasRefraction;
+    values[SNELL_SPEC_HAS_REFLECTION] = scene_.anyReflection();
+    values[SNELL_SPEC_HAS_LIGHTS] = !layout_.lights.empty();
+    values[SNELL_SPEC_COUNT_RAYS] = countRays;
+    values[SNELL_SPEC_MAX_MEDIA] = static_cast<std::uint32_t>(
+        std::clamp<std::size_t>(layout_.refractiveSpheres, 1, SNELL_MAX_MEDIA_LIMIT));
+    // Depth-first with two children per ray: at most maxDepth + 1 rays wait.
+    values[SNELL_SPEC_RAY_STACK] = static_cast<std::uint32_t>(
+        (hasRefraction || scene_.anyReflection()) ? request.trace.maxDepth + 1 : 1);
+    values[SNELL_SPEC_AMPLIFYING] = layout_.amplifying;
+    std::array<VkSpecializationMapEntry, 9> entries{};
+    for (std::uint32_t i = 0; i < entries.size(); ++i)
+        entries[i] = {i, i * static_cast<std::uint32_t>(sizeof(std::uint32_t)), sizeof(std::uint32_t)};
+    VkSpecializationInfo spec{static_cast<std::uint32_t>(entries.size()), entries.data(),
+                              values.size() * sizeof(std::uint32_t), values.data()};
+    VkComputePipelineCreateInfo pipelineInfo{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
+    pipelineInfo.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
+    pipelineInfo.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+    pipelineInfo.stage.module = p.module;
+    pipelineInfo.stage.pName = "main";
+    pipelineInfo.stage.pSpecializationInfo = &spec;
+    pipelineInfo.layout = p.layout;
+    check(vkCreateComputePipelines(device, VK_NULL_HANDLE, 1, &pipelineInfo, nullptr, &p.pipeline),
+          "vkCreateComputePipelines");
+
+    std::array<VkDescriptorPoolSize, 3> sizes{{{VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1},
+                                               {VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1},
+                                               {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 6}}};
+    VkDescriptorPoolCreateInfo poolInfo{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
+    poolInfo.maxSets = 1;
+    poolInfo.poolSizeCount = static_cast<std::uint32_t>(sizes.size());
+    poolInfo.pPoolSizes = sizes.data();
+    check(vkCreateDescriptorPool(device, &poolInfo, nullptr, &p.pool), "vkCreateDescriptorPool");
+    VkDescriptorSetAllocateInfo alloc{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO};
+    alloc.descriptorPool = p.pool;
+    alloc.descriptorSetCount = 1;
+    alloc.pSetLayouts = &p.setLayout;
+    check(vkAllocateDescriptorSets(device, &alloc, &p.set), "vkAllocateDescriptorSets");
+
+    VkCommandPoolCreateInfo cpInfo{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+    cpInfo.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+    cpInfo.queueFamilyIndex = context_.queueFamily();
+    check(vkCreateCommandPool(device, &cpInfo, nullptr, &p.commandPool), "vkCreateCommandPool");
+    VkCommandBufferAllocateInfo cbInfo{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+    cbInfo.commandPool = p.commandPool;
+    cbInfo.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+    cbInfo.commandBufferCount = 1;
+    check(vkAllocateCommandBuffers(device, &cbInfo, &p.commands), "vkAllocateCommandBuffers");
+    VkFenceCreateInfo fenceInfo{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+    check(vkCreateFence(device, &fenceInfo, nullptr, &p.fence), "vkCreateFence");
+    if (context_.timestampsSupported()) {
+        VkQueryPoolCreateInfo q{VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO};
+        q.queryType = VK_QUERY_TYPE_TIMESTAMP;
+        q.queryCount = 2;
+        check(vkCreateQueryPool(device, &q, nullptr, &p.queries), "vkCreateQueryPool");
+    }
+}
+
+void ComputeRenderer::destroyPipeline(Pipeline& p) {
+    VkDevice device = context_.device();
+    vkDeviceWaitIdle(device);
+    if (p.queries) vkDestroyQueryPool(device, p.queries, nullptr);
+    if (p.fence) vkDestroyFence(device, p.fence, nullptr);
+    if (p.commandPool) vkDestroyCommandPool(device, p.commandPool, nullptr);
+    if (p.pool) vkDestroyDescriptorPool(device, p.pool, nullptr);
+    if (p.pipeline) vkDestroyPipeline(device, p.pipeline, nullptr);
+    if (p.module) vkDestroyShaderModule(device, p.module, nullptr);
+    if (p.layout) vkDestroyPipelineLayout(device, p.layout, nullptr);
+    if (p.setLayout) vkDestroyDescriptorSetLayout(device, p.setLayout, nullptr);
+    context_.destroy(p.frame);
+    context_.destroy(p.counters);
+    context_.destroy(p.readback);
+    context_.destroy(p.image);
+}
+
+GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool countRays) {
+    if (request.camera.eye != layout_.eye)
+        throw vk::VulkanError("internal error: the camera moved without rebuilding the GPU scene");
+    GpuRenderResult result;
+    result.image = Image(request.width, request.height);
+    Pipeline p;
+    try {
+        const auto pipelineStart = Clock::now();
+        createPipeline(request, countRays, p);
+        result.pipelineMs = msSince(pipelineStart);
+
+        // Tiles: square, a multiple of the workgroup, sized by rays per submission.
+        const int s = std::max(1, request.supersample);
+        const auto side = static_cast<int>(std::sqrt(double(kRaysPerTile) / (double(s) * s)));
+        const int tileSide = std::clamp(side / 8 * 8, 8, 1024);
+        const int tileW = std::min(tileSide, request.width);
+        const int tileH = std::min(tileSide, request.height);
+
+        const gpu::FrameParams frame = gpu::makeFrameParams(scene_, layout_, request.camera, request.width,
+                                                            request.height, s, request.trace.maxDepth,
+                                                            request.trace.minWeight);
+        p.frame = context_.createBufferWithData(&frame, sizeof frame, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
+        p.counters = context_.createBuffer(SNELL_COUNTER_COUNT * sizeof(std::uint32_t),
+                                           kStorage | VK_BUFFER_USAGE_TRANSFER_DST_BIT, true);
+        p.image = context_.createStorageImage(tileW, tileH, VK_FORMAT_R32G32B32A32_SFLOAT);
+        p.readback = context_.createBuffer(VkDeviceSize(tileW) * tileH * 4 * sizeof(float),
+                                           VK_BUFFER_USAGE_TRANSFER_DST_BIT, true);
+
+        VkDescriptorImageInfo imageInfo{VK_NULL_HANDLE, p.image.view, VK_IMAGE_LAYOUT_GENERAL};
+        std::array<VkDescriptorBufferInfo, 8> bufferInfo{};
+        const vk::Buffer* buffers[8] = {nullptr, &p.frame, &spheres_, &ellipsoids_, &materials_, &lights_, &nodes_, &p.counters};
+        std::array<VkWriteDescriptorSet, 8> writes{};
+        for (std::uint32_t i = 0; i < 8; ++i) {
+            writes[i] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+            writes[i].dstSet = p.set;
+            writes[i].dstBinding = i;
+            writes[i].descriptorCount = 1;
+            if (i == SNELL_BINDING_OUTPUT_IMAGE) {
+                writes[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
+                writes[i].pImageInfo = &imageInfo;
+            } else {
+                bufferInfo[i] = {buffers[i]->buffer, 0, VK_WHOLE_SIZE};
+                writes[i].descriptorType = i == SNELL_BINDING_FRAME ? VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER
+                                                                     : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+                writes[i].pBufferInfo = &bufferInfo[i];
+            }
+        }
+        vkUpdateDescriptorSets(context_.device(), static_cast<std::uint32_t>(writes.size()), writes.data(), 0, nullptr);
+
+        const int tilesX = (request.width + tileW - 1) / tileW;
+        const int tilesY = (request.height + tileH - 1) / tileH;
+        const int tileCount = tilesX * tilesY;
+        double hostRenderMs = 0.0, gpuRenderMs = 0.0;
+        bool first = true;
+        for (int ty = 0; ty < tilesY; ++ty) {
+            for (int tx = 0; tx < tilesX; ++tx) {
+                if (request.cancel && request.cancel->load()) throw vk::VulkanError("render cancelled");
+                gpu::TileParams tile{std::uint32_t(tx * tileW), std::uint32_t(ty * tileH),
+                                     std::uint32_t(std::min(tileW, request.width - tx * tileW)),
+                                     std::uint32_t(std::min(tileH, request.height - ty * tileH))};
+                std::memset(p.counters.mapped, 0, SNELL_COUNTER_COUNT * sizeof(std::uint32_t));
+                VkCommandBuffer cmd = p.commands;
+                check(vkResetCommandBuffer(cmd, 0), "vkResetCommandBuffer");
+                VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+                begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+                check(vkBeginCommandBuffer(cmd, &begin), "vkBeginCommandBuffer");
+                VkImageMemoryBarrier toGeneral{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
+                toGeneral.srcAccessMask = first ? 0 : VK_ACCESS_TRANSFER_READ_BIT;
+                toGeneral.dstAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
+                toGeneral.oldLayout = first ? VK_IMAGE_LAYOUT_UNDEFINED : VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
+                toGeneral.newLayout = VK_IMAGE_LAYOUT_GENERAL;
+                toGeneral.srcQueueFamilyIndex = toGeneral.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+                toGeneral.image = p.image.image;
+                toGeneral.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+                vkCmdPipelineBarrier(cmd, first ? VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT : VK_PIPELINE_STAGE_TRANSFER_BIT,
+                                     VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 0, nullptr, 0, nullptr, 1, &toGeneral);
+                first = false;
+                if (p.queries) {
+                    vkCmdResetQueryPool(cmd, p.queries, 0, 2);
+                    vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, p.queries, 0);
+                }
+                vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.pipeline);
+                vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.layout, 0, 1, &p.set, 0, nullptr);
+                vkCmdPushConstants(cmd, p.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof tile, &tile);
+                vkCmdDispatch(cmd, (tile.width + SNELL_WORKGROUP_SIZE_X - 1) / SNELL_WORKGROUP_SIZE_X,
+                              (tile.height + SNELL_WORKGROUP_SIZE_Y - 1) / SNELL_WORKGROUP_SIZE_Y, 1);
+                if (p.queries) vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, p.queries, 1);
+                VkImageMemoryBarrier toCopy = toGeneral;
+                toCopy.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
+                toCopy.dstAccessMask = VK_ACCESS_TRANSFER_READ_BIT;
+                toCopy.oldLayout = VK_IMAGE_LAYOUT_GENERAL;
+                toCopy.newLayout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
+                vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0,
+                                     nullptr, 0, nullptr, 1, &toCopy);
+                VkBufferImageCopy region{};
+                region.bufferRowLength = tileW;
+                region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+                region.imageExtent = {tile.width, tile.height, 1};
+                vkCmdCopyImageToBuffer(cmd, p.image.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, p.readback.buffer, 1, &region);
+                VkMemoryBarrier toHost{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+                toHost.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_SHADER_WRITE_BIT;
+                toHost.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
+                vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                                     VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &toHost, 0, nullptr, 0, nullptr);
+                check(vkEndCommandBuffer(cmd), "vkEndCommandBuffer");
+
+                const auto submitStart = Clock::now();
+                VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+                submit.commandBufferCount = 1;
+                submit.pCommandBuffers = &cmd;
+                check(vkQueueSubmit(context_.queue(), 1, &submit, p.fence), "vkQueueSubmit");
+                check(vkWaitForFences(context_.device(), 1, &p.fence, VK_TRUE, UINT64_MAX), "vkWaitForFences");
+                check(vkResetFences(context_.device(), 1, &p.fence), "vkResetFences");
+                hostRenderMs += msSince(submitStart);
+                if (p.queries) {
+                    std::uint64_t stamps[2] = {0, 0};
+                    check(vkGetQueryPoolResults(context_.device(), p.queries, 0, 2, sizeof stamps, stamps,
+                                                sizeof(std::uint64_t), VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
+                          "vkGetQueryPoolResults");
+                    gpuRenderMs += double(stamps[1] - stamps[0]) * context_.properties().limits.timestampPeriod * 1e-6;
+                }
+                const auto readStart = Clock::now();
+                const auto* texels = static_cast<const float*>(p.readback.mapped);
+                for (std::uint32_t y = 0; y < tile.height; ++y) {
+                    float* row = result.image.pixel(tile.originX, tile.originY + y);
+                    const float* src = texels + std::size_t(y) * tileW * 4;
+                    for (std::uint32_t x = 0; x < tile.width; ++x) {
+                        row[x * 3 + 0] = src[x * 4 + 0];
+                        row[x * 3 + 1] = src[x * 4 + 1];
+                        row[x * 3 + 2] = src[x * 4 + 2];
+                    }
+                }
+                if (countRays) {
+                    const auto* c = static_cast<const std::uint32_t*>(p.counters.mapped);
+                    result.rays.primary += c[SNELL_COUNTER_PRIMARY];
+                    result.rays.shadow += c[SNELL_COUNTER_SHADOW];
+                    result.rays.reflected += c[SNELL_COUNTER_REFLECTED];
+                    result.rays.refracted += c[SNELL_COUNTER_REFRACTED];
+                }
+                result.readbackMs += msSince(readStart);
+                ++result.tiles;
+                if (request.progress) request.progress(double(result.tiles) / tileCount);
+            }
+        }
+        result.gpuTimed = p.queries != VK_NULL_HANDLE;
+        result.renderMs = result.gpuTimed ? gpuRenderMs : hostRenderMs;
+    } catch (...) {
+        destroyPipeline(p);
+        throw;
+    }
+    destroyPipeline(p);
+    return result;
+}
+
+}  // namespace snell

@@ -1,0 +1,51 @@
+// The compute renderer: uploads a scene's GPU layout (GpuScene.h), builds the
+// pipeline of shaders/trace.comp specialised to the scene, and renders images
+// in tiles so no single submission runs for long.
+#pragma once
+
+#include <memory>
+
+#include "gpu/GpuScene.h"
+#include "image/Image.h"
+#include "render/RenderRequest.h"
+#include "vulkan/VulkanContext.h"
+
+namespace snell {
+
+struct GpuRenderResult {
+    Image image;
+    RayCounts rays;           // filled when counting was asked for
+    double renderMs = 0.0;    // the dispatches alone
+    bool gpuTimed = false;    // renderMs from GPU timestamps (else host timing)
+    double pipelineMs = 0.0;  // shader pipeline creation
+    double readbackMs = 0.0;  // copying tiles back into the image
+    int tiles = 0;
+};
+
+class ComputeRenderer {
+public:
+    // Uploads the scene; `camera.eye` becomes the GPU's coordinate origin.
+    ComputeRenderer(vk::Context& context, const Scene& scene, const Camera& camera);
+    ~ComputeRenderer();
+    ComputeRenderer(const ComputeRenderer&) = delete;
+    ComputeRenderer& operator=(const ComputeRenderer&) = delete;
+
+    double uploadMs() const { return uploadMs_; }
+    const gpu::GpuScene& layout() const { return layout_; }
+
+    // Render request.camera (its eye must be the one given at construction).
+    GpuRenderResult render(const RenderRequest& request, bool countRays);
+
+private:
+    struct Pipeline;
+    void createPipeline(const RenderRequest& request, bool countRays, Pipeline& pipeline);
+    void destroyPipeline(Pipeline& pipeline);
+
+    vk::Context& context_;
+    const Scene& scene_;
+    gpu::GpuScene layout_;
+    vk::Buffer spheres_, ellipsoids_, materials_, lights_, nodes_;
+    double uploadMs_ = 0.0;
+};
+
+}  // namespace snell

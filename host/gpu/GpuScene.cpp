@@ -1,0 +1,103 @@
+#include "gpu/GpuScene.h"
+
+#include <chrono>
+#include <cmath>
+
+#include "bvh/Bvh.h"
+
+namespace snell::gpu {
+namespace {
+
+vec4 toVec4(const snell::dvec3& v, double w) {
+    return vec4(static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z), static_cast<float>(w));
+}
+
+// Round a box outwards to float so it still contains the double box.
+void outwardBox(const snell::Aabb& box, const snell::dvec3& eye, vec4& lower, vec4& upper) {
+    for (int k = 0; k < 3; ++k) {
+        const double lo = box.lower[k] - eye[k];
+        const double hi = box.upper[k] - eye[k];
+        float l = static_cast<float>(lo), h = static_cast<float>(hi);
+        if (static_cast<double>(l) > lo) l = std::nextafter(l, -INFINITY);
+        if (static_cast<double>(h) < hi) h = std::nextafter(h, INFINITY);
+        lower[k] = l;
+        upper[k] = h;
+    }
+    lower.w = upper.w = 0.0f;
+}
+
+}  // namespace
+
+GpuScene buildGpuScene(const snell::Scene& scene, const snell::Camera& camera) {
+    GpuScene out;
+    out.eye = camera.eye;
+    const snell::dvec3 eye = camera.eye;
+    // Camera-relative: objectFromCamera = objectFromWorld · T(eye), in double.
+    snell::dmat4 worldFromCamera(1.0);
+    worldFromCamera[3] = glm::dvec4(eye, 1.0);
+
+    std::vector<std::uint32_t> order(scene.spheres.size());
+    for (std::uint32_t i = 0; i < order.size(); ++i) order[i] = i;
+    if (scene.spheres.size() > kBvhThreshold) {
+        const auto start = std::chrono::steady_clock::now();
+        std::vector<snell::Aabb> bounds;
+        bounds.reserve(scene.spheres.size());
+        for (const snell::Sphere& s : scene.spheres) bounds.push_back(snell::sphereBounds(s));
+        const snell::Bvh bvh = snell::buildBvh(bounds);
+        out.nodes.reserve(bvh.nodes.size());
+        for (const snell::BvhNode& n : bvh.nodes) {
+            BvhNode node{};
+            outwardBox(n.bounds, eye, node.lower, node.upper);
+            node.first = n.first;
+            node.count = n.count;
+            out.nodes.push_back(node);
+        }
+        order = bvh.order;
+        out.bvhDepth = bvh.depth;
+        out.bvhBuildMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    }
+
+    out.spheres.reserve(scene.spheres.size());
+    for (std::uint32_t index : order) {
+        const snell::Sphere& s = scene.spheres[index];
+        Sphere g{};
+        g.material = s.material;
+        g.centreRadius = toVec4(s.centre - eye, s.radius);
+        g.ellipsoid = SNELL_NOT_ELLIPSOID;
+        if (!s.isTrueSphere) {
+            g.ellipsoid = static_cast<uint>(out.ellipsoids.size());
+            Ellipsoid e;
+            e.objectFromWorld = mat4(s.objectFromWorld * worldFromCamera);
+            out.ellipsoids.push_back(e);
+        }
+        if (scene.materials[s.material].refracts()) ++out.refractiveSpheres;
+        out.spheres.push_back(g);
+    }
+    for (const snell::Material& m : scene.materials) {
+        out.materials.push_back({toVec4(m.kd, m.phong), toVec4(m.ks, 0.0), toVec4(m.kt, m.eta)});
+        out.amplifying |= m.amplifies();
+    }
+    for (const snell::Light& l : scene.lights)
+        out.lights.push_back({toVec4(l.position - eye, 1.0), toVec4(l.colour, 0.0)});
+    return out;
+}
+
+FrameParams makeFrameParams(const snell::Scene& scene, const GpuScene& gpuScene, const snell::Camera& camera,
+                            int width, int height, int supersample, int maxDepth, double minWeight) {
+    FrameParams f{};
+    f.cornerDir = toVec4(camera.cornerDir, 0.0);
+    f.pixelRight = toVec4(camera.pixelRight, 0.0);
+    f.pixelDown = toVec4(camera.pixelDown, 0.0);
+    f.background = toVec4(scene.background, snell::kAirEta);
+    f.ambient = toVec4(scene.ambient, minWeight);
+    f.imageWidth = static_cast<uint>(width);
+    f.imageHeight = static_cast<uint>(height);
+    f.supersample = static_cast<uint>(supersample);
+    f.maxDepth = static_cast<uint>(maxDepth);
+    f.sphereCount = static_cast<uint>(gpuScene.spheres.size());
+    f.lightCount = static_cast<uint>(gpuScene.lights.size());
+    f.bvhNodeCount = static_cast<uint>(gpuScene.nodes.size());
+    return f;
+}
+
+}  // namespace snell::gpu

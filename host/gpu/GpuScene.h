@@ -1,0 +1,46 @@
+// The scene's GPU layout: what the compute shader reads, prepared in double on
+// the host. Camera-relative coordinates (world minus eye) keep precision where
+// the rays start; true spheres are centre + radius, only ellipsoids carry
+// matrices; spheres are in BVH leaf order when a BVH is used. No Vulkan here.
+#pragma once
+
+#include <cstddef>
+#include <vector>
+
+#include "scene/Scene.h"
+#include "shared_layout.h"
+
+namespace snell::gpu {
+
+static_assert(sizeof(Sphere) == 32 && offsetof(Sphere, material) == 16 && offsetof(Sphere, ellipsoid) == 20);
+static_assert(sizeof(Ellipsoid) == 64);
+static_assert(sizeof(Material) == 48 && offsetof(Material, kt) == 32);
+static_assert(sizeof(Light) == 32 && offsetof(Light, colour) == 16);
+static_assert(sizeof(BvhNode) == 48 && offsetof(BvhNode, first) == 32 && offsetof(BvhNode, count) == 36);
+static_assert(sizeof(FrameParams) == 112 && offsetof(FrameParams, imageWidth) == 80 &&
+              offsetof(FrameParams, bvhNodeCount) == 104);
+static_assert(sizeof(TileParams) == 16);
+
+// Spheres above this count are traversed through the BVH; fewer are tested in a loop.
+inline constexpr std::size_t kBvhThreshold = 8;
+
+struct GpuScene {
+    std::vector<Sphere> spheres;
+    std::vector<Ellipsoid> ellipsoids;
+    std::vector<Material> materials;
+    std::vector<Light> lights;
+    std::vector<BvhNode> nodes;  // empty when no BVH is used
+    std::size_t refractiveSpheres = 0;
+    bool amplifying = false;
+    snell::dvec3 eye{0.0};       // the world point that is the origin on the GPU
+    int bvhDepth = 0;
+    double bvhBuildMs = 0.0;
+};
+
+GpuScene buildGpuScene(const snell::Scene& scene, const snell::Camera& camera);
+
+// The frame parameters of one render (camera relative to camera.eye).
+FrameParams makeFrameParams(const snell::Scene& scene, const GpuScene& gpuScene, const snell::Camera& camera,
+                            int width, int height, int supersample, int maxDepth, double minWeight);
+
+}  // namespace snell::gpu

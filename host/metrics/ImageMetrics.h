@@ -1,0 +1,31 @@
+// Error metrics between a test image and a reference, in 8-bit units after the
+// SPEC §6 clamp and rounding: what "agrees with the exact image" means.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "image/Image.h"
+
+namespace snell {
+
+struct ImageMetrics {
+    double meanAbsError = 0.0;    // mean |a − b| over all channels, in 1/255 units
+    double rmse = 0.0;            // in 1/255 units
+    double psnr = 0.0;            // dB, 8-bit peak; +inf when identical
+    int maxError = 0;             // largest channel difference, in 1/255 units
+    std::uint64_t badPixels = 0;  // pixels with some channel off by > badThreshold
+    double badFraction = 0.0;
+    std::uint64_t nonFinite = 0;  // NaN or Inf values in the test image
+    std::uint64_t pixels = 0;
+    std::string json() const;
+};
+
+// Compare `test` against `reference` (same size, else std::invalid_argument).
+ImageMetrics compareImages(const Image& test, const Image& reference, int badThreshold = 3);
+
+// A false-colour difference image: black where equal, blue → red as the
+// largest channel difference grows to `fullScale`/255.
+Image differenceImage(const Image& test, const Image& reference, int fullScale = 16);
+
+}  // namespace snell

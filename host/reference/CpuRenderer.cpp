@@ -1,0 +1,312 @@
+#include "reference/CpuRenderer.h"
+
+#include <algorithm>
+#include <array>
+#include <thread>
+#include <vector>
+
+namespace snell {
+
+using glm::dvec3;
+
+namespace {
+
+constexpr std::uint32_t kNone = 0xffffffffu;
+constexpr int kMaxMedia = 128;
+constexpr std::size_t kBvhThreshold = 8;  // below this, a linear loop is as fast
+
+// SPEC §4 medium stack: the refractive spheres a ray is inside, innermost last.
+struct MediumStack {
+    int size = 0;
+    std::array<std::uint32_t, kMaxMedia> spheres{};
+
+    void push(std::uint32_t s) {
+        if (size == kMaxMedia) {  // deeper nesting than any real scene: forget the outermost
+            std::copy(spheres.begin() + 1, spheres.end(), spheres.begin());
+            --size;
+        }
+        spheres[size++] = s;
+    }
+    // Remove s wherever it is (SPEC: "or does nothing if it is not there").
+    void remove(std::uint32_t s) {
+        for (int i = size - 1; i >= 0; --i) {
+            if (spheres[i] == s) {
+                std::copy(spheres.begin() + i + 1, spheres.begin() + size, spheres.begin() + i);
+                --size;
+                return;
+            }
+        }
+    }
+};
+
+double maxComponent(const dvec3& v) { return std::max({v.x, v.y, v.z}); }
+
+bool rayHitsBox(const Aabb& box, const dvec3& origin, const dvec3& inverseDir, double tMax) {
+    // Slab test; inverseDir components may be ±inf, which the min/max handle.
+    double t0 = 0.0, t1 = tMax;
+    for (int k = 0; k < 3; ++k) {
+        double a = (box.lower[k] - origin[k]) * inverseDir[k];
+        double b = (box.upper[k] - origin[k]) * inverseDir[k];
+        if (std::isnan(a) || std::isnan(b)) continue;  // origin on a slab plane, parallel ray
+        if (a > b) std::swap(a, b);
+        t0 = std::max(t0, a);
+        t1 = std::min(t1, b);
+        if (t0 > t1) return false;
+    }
+    return true;
+}
+
+}  // namespace
+
+struct CpuRenderer::Hit {
+    double t = kNoHit;
+    std::uint32_t sphere = kNone;
+};
+
+struct CpuRenderer::PendingRay {
+    Ray ray;
+    dvec3 weight{1.0};
+    int depth = 0;
+    std::uint32_t fromSphere = kNone;  // the sphere whose surface the ray starts on
+    bool inward = false;               // it starts into that sphere
+    bool refracted = false;
+    MediumStack media;
+};
+
+CpuRenderer::CpuRenderer(const Scene& scene) : scene_(scene) {
+    amplifying_ = std::any_of(scene.materials.begin(), scene.materials.end(),
+                              [](const Material& m) { return m.amplifies(); });
+    useBvh_ = scene.spheres.size() > kBvhThreshold;
+    if (useBvh_) {
+        std::vector<Aabb> bounds;
+        bounds.reserve(scene.spheres.size());
+        for (const Sphere& s : scene.spheres) bounds.push_back(sphereBounds(s));
+        bvh_ = buildBvh(bounds);
+    }
+}
+
+double CpuRenderer::intersect(std::uint32_t index, const Ray& ray, std::uint32_t fromSphere,
+                              StartsOn start) const {
+    const Sphere& s = scene_.spheres[index];
+    const StartsOn mode = index == fromSphere ? start : StartsOn::Elsewhere;
+    if (s.isTrueSphere) return intersectSphere(s.centre, s.radius, ray, mode);
+    const dvec3 o = dvec3(s.objectFromWorld * glm::dvec4(ray.origin, 1.0));
+    const dvec3 d = glm::dmat3(s.objectFromWorld) * ray.direction;
+    return intersectUnitSphere(o, d, mode);
+}
+
+bool CpuRenderer::closestHit(const Ray& ray, std::uint32_t fromSphere, StartsOn start, Hit& hit) const {
+    hit = Hit{};
+    auto test = [&](std::uint32_t i) {
+        const double t = intersect(i, ray, fromSphere, start);
+        if (t < hit.t) { hit.t = t; hit.sphere = i; }
+    };
+    if (!useBvh_) {
+        for (std::uint32_t i = 0; i < scene_.spheres.size(); ++i) test(i);
+        return hit.sphere != kNone;
+    }
+    const dvec3 inverseDir = 1.0 / ray.direction;
+    std::uint32_t stack[128];
+    int top = 0;
+    stack[top++] = 0;
+    while (top > 0) {
+        const BvhNode& node = bvh_.nodes[stack[--top]];
+        if (!rayHitsBox(node.bounds, ray.origin, inverseDir, hit.t)) continue;
+        if (node.count > 0) {
+            for (std::uint32_t k = 0; k < node.count; ++k) test(bvh_.order[node.first + k]);
+        } else {
+            stack[top++] = node.first;
+            stack[top++] = node.first + 1;
+        }
+    }
+    return hit.sphere != kNone;
+}
+
+bool CpuRenderer::occluded(const Ray& ray, double distance, std::uint32_t fromSphere, StartsOn start) const {
+    // SPEC §4.3: blocked if a surface crosses the open segment (0, distance).
+    if (!useBvh_) {
+        for (std::uint32_t i = 0; i < scene_.spheres.size(); ++i)
+            if (intersect(i, ray, fromSphere, start) < distance) return true;
+        return false;
+    }
+    const dvec3 inverseDir = 1.0 / ray.direction;
+    std::uint32_t stack[128];
+    int top = 0;
+    stack[top++] = 0;
+    while (top > 0) {
+        const BvhNode& node = bvh_.nodes[stack[--top]];
+        if (!rayHitsBox(node.bounds, ray.origin, inverseDir, distance)) continue;
+        if (node.count > 0) {
+            for (std::uint32_t k = 0; k < node.count; ++k)
+                if (intersect(bvh_.order[node.first + k], ray, fromSphere, start) < distance) return true;
+        } else {
+            stack[top++] = node.first;
+            stack[top++] = node.first + 1;
+        }
+    }
+    return false;
+}
+
+// One sample's ray tree (SPEC §4), depth first with an explicit stack, adding
+// each ray's local term straight into pixelSum. A channel whose pixel sum has
+// reached `saturation` is final in 8 bits (SPEC §4 "amplifying materials"), so
+// its weight is dropped from then on.
+void CpuRenderer::trace(const PendingRay& primary, dvec3& pixelSum, double saturation,
+                        const TraceSettings& settings, RayCounts& counts) const {
+    std::vector<PendingRay> stack;
+    stack.push_back(primary);
+    ++counts.primary;
+    const double minWeight = settings.minWeight;
+    auto worthTracing = [&](const dvec3& w) {
+        const double m = maxComponent(w);
+        return m > 0.0 && m >= minWeight;
+    };
+    while (!stack.empty()) {
+        PendingRay r = std::move(stack.back());
+        stack.pop_back();
+        for (int k = 0; k < 3; ++k)
+            if (pixelSum[k] >= saturation) r.weight[k] = 0.0;
+        if (!worthTracing(r.weight)) continue;
+
+        // 1. Closest hit.
+        Hit hit;
+        const StartsOn start = r.inward ? StartsOn::Entering : StartsOn::Leaving;
+        if (!closestHit(r.ray, r.fromSphere, start, hit)) {
+            pixelSum += r.weight * scene_.background;
+            continue;
+        }
+        const Sphere& sphere = scene_.spheres[hit.sphere];
+        const Material& m = scene_.materials[sphere.material];
+
+        // 2. Hit point re-projected onto the surface, outward normal No, shading normal N.
+        dvec3 x, outward;
+        if (sphere.isTrueSphere) {
+            outward = glm::normalize(r.ray.origin - sphere.centre + hit.t * r.ray.direction);
+            x = sphere.centre + sphere.radius * outward;
+        } else {
+            const dvec3 o = dvec3(sphere.objectFromWorld * glm::dvec4(r.ray.origin, 1.0));
+            const dvec3 d = glm::dmat3(sphere.objectFromWorld) * r.ray.direction;
+            // As in the shader: no re-projection for ellipsoids (see trace.comp).
+            const dvec3 p = o + hit.t * d;
+            x = r.ray.origin + hit.t * r.ray.direction;
+            outward = glm::normalize(glm::transpose(glm::dmat3(sphere.objectFromWorld)) * p);
+        }
+        const dvec3 d = r.ray.direction;
+        const bool fromOutside = glm::dot(d, outward) < 0.0;
+        const dvec3 n = fromOutside ? outward : -outward;
+        const dvec3 v = -d;
+
+        // 3. Local Phong term with binary shadows.
+        dvec3 local = scene_.ambient * m.kd;
+        for (const Light& light : scene_.lights) {
+            dvec3 l = light.position - x;
+            const double distance = glm::length(l);
+            l /= distance;
+            const double nl = glm::dot(n, l);
+            if (!(nl > 0.0)) continue;
+            ++counts.shadow;
+            // A shadow ray towards N's side enters the sphere only when N = −No.
+            if (occluded({x, l}, distance, hit.sphere, fromOutside ? StartsOn::Leaving : StartsOn::Entering))
+                continue;
+            const dvec3 reflectedLight = 2.0 * nl * n - l;
+            const double rv = glm::dot(reflectedLight, v);
+            const double specular = rv > 0.0 ? std::pow(rv, m.phong) : 0.0;
+            local += light.colour * (m.kd * nl + m.ks * specular);
+        }
+        pixelSum += r.weight * local;
+        if (r.depth >= settings.maxDepth) continue;
+
+        // 4–5. Children: reflection, and refraction through the medium stack.
+        dvec3 reflectedWeight = r.weight * m.ks;
+        if (m.refracts()) {
+            const dvec3 transmittedWeight = r.weight * m.kt;
+            MediumStack media = r.media;
+            double etaI, etaT;
+            if (fromOutside) {
+                etaI = media.size > 0 ? scene_.materials[scene_.spheres[media.spheres[media.size - 1]].material].eta : kAirEta;
+                etaT = m.eta;
+                media.push(hit.sphere);
+            } else {
+                etaI = m.eta;
+                media.remove(hit.sphere);
+                etaT = media.size > 0 ? scene_.materials[scene_.spheres[media.spheres[media.size - 1]].material].eta : kAirEta;
+            }
+            dvec3 refracted;
+            if (!refractDirection(d, n, etaI / etaT, refracted)) {
+                // Total internal reflection is the reflected ray in the same
+                // medium: one ray carrying both weights (exactly SPEC §4.5).
+                reflectedWeight += transmittedWeight;
+            } else if (worthTracing(transmittedWeight)) {
+                ++counts.refracted;
+                stack.push_back({{x, refracted}, transmittedWeight, r.depth + 1, hit.sphere,
+                                 fromOutside, true, media});
+            }
+        }
+        if (worthTracing(reflectedWeight)) {
+            ++counts.reflected;
+            stack.push_back({{x, reflectDirection(d, n)}, reflectedWeight, r.depth + 1, hit.sphere,
+                             !fromOutside, false, r.media});
+        }
+    }
+}
+
+glm::dvec3 CpuRenderer::renderPixel(const RenderRequest& request, int x, int y, RayCounts& counts) const {
+    const int s = std::max(1, request.supersample);
+    const double samples = static_cast<double>(s) * s;
+    // Only amplifying scenes stop saturated channels: elsewhere the float
+    // output keeps the whole unclamped sum (SPEC §6).
+    const double saturation = amplifying_ ? samples : kNoHit;
+    dvec3 sum(0.0);
+    for (int b = 0; b < s; ++b) {
+        for (int a = 0; a < s; ++a) {
+            // SPEC §3: sub-pixel (a, b) at x = i + (a + ½)/s, y = j + (b + ½)/s.
+            const double px = x + (a + 0.5) / s;
+            const double py = y + (b + 0.5) / s;
+            PendingRay primary;
+            primary.ray = {request.camera.eye, request.camera.direction(px, py)};
+            trace(primary, sum, saturation, request.trace, counts);
+        }
+    }
+    return sum / samples;
+}
+
+Image CpuRenderer::render(const RenderRequest& request, RayCounts* counts) const {
+    Image image(request.width, request.height);
+    const int threads = request.threads > 0
+                            ? request.threads
+                            : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+    std::atomic<int> nextRow{0};
+    std::atomic<int> rowsDone{0};
+    std::vector<RayCounts> perThread(threads);
+    auto work = [&](int id) {
+        RayCounts& local = perThread[id];
+        for (int y; (y = nextRow.fetch_add(1)) < request.height;) {
+            if (request.cancel && request.cancel->load()) return;
+            for (int x = 0; x < request.width; ++x) {
+                const dvec3 c = renderPixel(request, x, y, local);
+                float* p = image.pixel(x, y);
+                p[0] = static_cast<float>(c.x);
+                p[1] = static_cast<float>(c.y);
+                p[2] = static_cast<float>(c.z);
+            }
+            const int done = rowsDone.fetch_add(1) + 1;
+            if (request.progress) request.progress(static_cast<double>(done) / request.height);
+        }
+    };
+    std::vector<std::thread> pool;
+    for (int t = 1; t < threads; ++t) pool.emplace_back(work, t);
+    work(0);
+    for (std::thread& t : pool) t.join();
+    if (counts) {
+        *counts = RayCounts{};
+        for (const RayCounts& c : perThread) {
+            counts->primary += c.primary;
+            counts->shadow += c.shadow;
+            counts->reflected += c.reflected;
+            counts->refracted += c.refracted;
+        }
+    }
+    return image;
+}
+
+}  // namespace snell

@@ -1,0 +1,44 @@
+// What a render is asked to do and what it counts, whichever back end does
+// it: the CPU reference (host/reference) or the compute shader (host/gpu).
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+
+#include "scene/Scene.h"
+
+namespace snell {
+
+struct TraceSettings {
+    int maxDepth = 64;          // reflection/refraction generations below the primary ray
+    double minWeight = 1e-7;    // Hall & Greenberg cut-off on a ray's weight; 0 turns it off
+};
+
+// The converged settings used to compute the exact image (SPEC §4).
+inline constexpr TraceSettings kReferenceSettings{64, 1e-7};
+// What `snell render` uses unless told otherwise (see README, "Defaults").
+inline constexpr TraceSettings kDefaultSettings{32, 5e-4};
+
+struct RayCounts {
+    std::uint64_t primary = 0;
+    std::uint64_t shadow = 0;
+    std::uint64_t reflected = 0;
+    std::uint64_t refracted = 0;
+    std::uint64_t total() const { return primary + shadow + reflected + refracted; }
+};
+
+struct RenderRequest {
+    Camera camera;
+    int width = 0;
+    int height = 0;
+    int supersample = 1;
+    TraceSettings trace;
+    int threads = 0;  // 0: all hardware threads
+    // Called now and then from worker threads with the fraction done.
+    std::function<void(double)> progress;
+    // Set to true from anywhere to stop early (the result is then incomplete).
+    const std::atomic<bool>* cancel = nullptr;
+};
+
+}  // namespace snell

@@ -1,0 +1,481 @@
+#include "vulkan/VulkanContext.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <cstring>
+
+namespace snell::vk {
+
+namespace {
+
+constexpr const char* kInstallHint =
+    "install a Vulkan driver: on Debian/Ubuntu 'apt-get install mesa-vulkan-drivers' gives the "
+    "lavapipe CPU device (or install your GPU's Vulkan driver)";
+
+const char* typeName(VkPhysicalDeviceType t) {
+    switch (t) {
+    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: return "discrete GPU";
+    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: return "integrated GPU";
+    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: return "virtual GPU";
+    case VK_PHYSICAL_DEVICE_TYPE_CPU: return "CPU";
+    default: return "other";
+    }
+}
+
+int typeRank(VkPhysicalDeviceType t) {
+    switch (t) {
+    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU: return 4;
+    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: return 3;
+    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU: return 2;
+    case VK_PHYSICAL_DEVICE_TYPE_CPU: return 1;
+    default: return 0;
+    }
+}
+
+std::string versionString(std::uint32_t v) {
+    return std::to_string(VK_API_VERSION_MAJOR(v)) + "." + std::to_string(VK_API_VERSION_MINOR(v)) + "." +
+           std::to_string(VK_API_VERSION_PATCH(v));
+}
+
+bool hasLayer(const char* name) {
+    std::uint32_t count = 0;
+    vkEnumerateInstanceLayerProperties(&count, nullptr);
+    std::vector<VkLayerProperties> layers(count);
+    vkEnumerateInstanceLayerProperties(&count, layers.data());
+    return std::any_of(layers.begin(), layers.end(), [&](const VkLayerProperties& l) { return std::strcmp(l.layerName, name) == 0; });
+}
+
+// Check a physical device for what snell needs; fills `family` and a report.
+DeviceReport examine(VkPhysicalDevice device, int index, std::uint32_t& family,
+                     const std::vector<std::string>& extensions) {
+    DeviceReport report;
+    report.index = index;
+    VkPhysicalDeviceProperties props;
+    vkGetPhysicalDeviceProperties(device, &props);
+    VkPhysicalDeviceDriverProperties driver{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES};
+    VkPhysicalDeviceProperties2 props2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, &driver};
+    if (props.apiVersion >= VK_API_VERSION_1_2) vkGetPhysicalDeviceProperties2(device, &props2);
+    report.name = props.deviceName;
+    report.type = typeName(props.deviceType);
+    report.driver = std::string(driver.driverName) + (driver.driverInfo[0] ? std::string(" ") + driver.driverInfo : "");
+    if (props.apiVersion < VK_API_VERSION_1_2) {
+        report.reason = "supports Vulkan " + versionString(props.apiVersion) + ", snell needs 1.2";
+        return report;
+    }
+    std::uint32_t count = 0;
+    vkGetPhysicalDeviceQueueFamilyProperties(device, &count, nullptr);
+    std::vector<VkQueueFamilyProperties> families(count);
+    vkGetPhysicalDeviceQueueFamilyProperties(device, &count, families.data());
+    bool found = false;
+    for (std::uint32_t i = 0; i < count && !found; ++i) {
+        if (families[i].queueFlags & VK_QUEUE_COMPUTE_BIT) { family = i; found = true; }
+    }
+    if (!found) {
+        report.reason = "has no compute queue";
+        return report;
+    }
+    std::uint32_t extCount = 0;
+    vkEnumerateDeviceExtensionProperties(device, nullptr, &extCount, nullptr);
+    std::vector<VkExtensionProperties> available(extCount);
+    vkEnumerateDeviceExtensionProperties(device, nullptr, &extCount, available.data());
+    for (const std::string& e : extensions) {
+        if (std::none_of(available.begin(), available.end(),
+                         [&](const VkExtensionProperties& p) { return e == p.extensionName; })) {
+            report.reason = "lacks the device extension " + e;
+            return report;
+        }
+    }
+    VkFormatProperties format;
+    vkGetPhysicalDeviceFormatProperties(device, VK_FORMAT_R32G32B32A32_SFLOAT, &format);
+    if (!(format.optimalTilingFeatures & VK_FORMAT_FEATURE_STORAGE_IMAGE_BIT)) {
+        report.reason = "cannot use RGBA32F as a storage image";
+        return report;
+    }
+    report.usable = true;
+    return report;
+}
+
+VkInstance createInstance(const std::vector<std::string>& extensions, bool validation, bool& debugUtils) {
+    VkApplicationInfo app{VK_STRUCTURE_TYPE_APPLICATION_INFO};
+    app.pApplicationName = "snell";
+    app.applicationVersion = VK_MAKE_API_VERSION(0, 1, 0, 0);
+    app.pEngineName = "snell";
+    app.apiVersion = VK_API_VERSION_1_2;
+    std::vector<const char*> exts;
+    for (const std::string& e : extensions) exts.push_back(e.c_str());
+    std::vector<const char*> layers;
+    debugUtils = false;
+    if (validation) {
+        if (!hasLayer("VK_LAYER_KHRONOS_validation"))
+            throw VulkanError("validation was requested but VK_LAYER_KHRONOS_validation is not installed "
+                              "(apt-get install vulkan-validationlayers)");
+        layers.push_back("VK_LAYER_KHRONOS_validation");
+        exts.push_back(VK_EXT_DEBUG_UTILS_EXTENSION_NAME);
+        debugUtils = true;
+    }
+    VkInstanceCreateInfo info{VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO};
+    info.pApplicationInfo = &app;
+    info.enabledExtensionCount = static_cast<std::uint32_t>(exts.size());
+    info.ppEnabledExtensionNames = exts.data();
+    info.enabledLayerCount = static_cast<std::uint32_t>(layers.size());
+    info.ppEnabledLayerNames = layers.data();
+    VkInstance instance = VK_NULL_HANDLE;
+    const VkResult r = vkCreateInstance(&info, nullptr, &instance);
+    if (r == VK_ERROR_INCOMPATIBLE_DRIVER || r == VK_ERROR_INITIALIZATION_FAILED)
+        throw NoDeviceError(std::string("no Vulkan driver found (vkCreateInstance: ") + resultName(r) + "): " + kInstallHint, r);
+    check(r, "vkCreateInstance");
+    return instance;
+}
+
+std::vector<VkPhysicalDevice> enumerate(VkInstance instance) {
+    std::uint32_t count = 0;
+    check(vkEnumeratePhysicalDevices(instance, &count, nullptr), "vkEnumeratePhysicalDevices");
+    std::vector<VkPhysicalDevice> devices(count);
+    check(vkEnumeratePhysicalDevices(instance, &count, devices.data()), "vkEnumeratePhysicalDevices");
+    devices.resize(count);
+    return devices;
+}
+
+}  // namespace
+
+const char* resultName(VkResult result) {
+    switch (result) {
+#define SNELL_CASE(x) case x: return #x;
+    SNELL_CASE(VK_SUCCESS) SNELL_CASE(VK_NOT_READY) SNELL_CASE(VK_TIMEOUT) SNELL_CASE(VK_INCOMPLETE)
+    SNELL_CASE(VK_ERROR_OUT_OF_HOST_MEMORY) SNELL_CASE(VK_ERROR_OUT_OF_DEVICE_MEMORY)
+    SNELL_CASE(VK_ERROR_INITIALIZATION_FAILED) SNELL_CASE(VK_ERROR_DEVICE_LOST)
+    SNELL_CASE(VK_ERROR_MEMORY_MAP_FAILED) SNELL_CASE(VK_ERROR_LAYER_NOT_PRESENT)
+    SNELL_CASE(VK_ERROR_EXTENSION_NOT_PRESENT) SNELL_CASE(VK_ERROR_FEATURE_NOT_PRESENT)
+    SNELL_CASE(VK_ERROR_INCOMPATIBLE_DRIVER) SNELL_CASE(VK_ERROR_TOO_MANY_OBJECTS)
+    SNELL_CASE(VK_ERROR_FORMAT_NOT_SUPPORTED) SNELL_CASE(VK_ERROR_FRAGMENTED_POOL)
+    SNELL_CASE(VK_ERROR_OUT_OF_POOL_MEMORY) SNELL_CASE(VK_ERROR_SURFACE_LOST_KHR)
+    SNELL_CASE(VK_ERROR_OUT_OF_DATE_KHR) SNELL_CASE(VK_SUBOPTIMAL_KHR)
+    SNELL_CASE(VK_ERROR_NATIVE_WINDOW_IN_USE_KHR) SNELL_CASE(VK_ERROR_UNKNOWN)
+#undef SNELL_CASE
+    default: return "VkResult(unknown)";
+    }
+}
+
+void check(VkResult result, const char* call) {
+    if (result >= 0) return;
+    std::string message = std::string(call) + " failed with " + resultName(result);
+    switch (result) {
+    case VK_ERROR_DEVICE_LOST:
+        message += ": the Vulkan device was lost (driver crash, GPU reset or a render that ran too long); "
+                   "no image was written. Try a smaller --size, or update the driver";
+        break;
+    case VK_ERROR_OUT_OF_DEVICE_MEMORY:
+        message += ": the device ran out of memory; try a smaller --size or a scene with fewer spheres";
+        break;
+    case VK_ERROR_OUT_OF_HOST_MEMORY:
+        message += ": the host ran out of memory";
+        break;
+    default: break;
+    }
+    throw VulkanError(message, result);
+}
+
+std::vector<DeviceReport> Context::listDevices() {
+    bool debugUtils = false;
+    VkInstance instance = createInstance({}, false, debugUtils);
+    std::vector<DeviceReport> reports;
+    try {
+        int index = 0;
+        for (VkPhysicalDevice d : enumerate(instance)) {
+            std::uint32_t family = 0;
+            reports.push_back(examine(d, index++, family, {}));
+        }
+    } catch (...) {
+        vkDestroyInstance(instance, nullptr);
+        throw;
+    }
+    vkDestroyInstance(instance, nullptr);
+    return reports;
+}
+
+Context::Context(const ContextOptions& options) {
+    bool debugUtils = false;
+    instance_ = createInstance(options.instanceExtensions, options.validation, debugUtils);
+    try {
+        if (debugUtils) {
+            auto create = reinterpret_cast<PFN_vkCreateDebugUtilsMessengerEXT>(
+                vkGetInstanceProcAddr(instance_, "vkCreateDebugUtilsMessengerEXT"));
+            VkDebugUtilsMessengerCreateInfoEXT info{VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT};
+            info.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+            info.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
+                               VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
+            info.pfnUserCallback = debugCallback;
+            info.pUserData = this;
+            if (create) check(create(instance_, &info, nullptr, &messenger_), "vkCreateDebugUtilsMessengerEXT");
+        }
+        const std::vector<VkPhysicalDevice> devices = enumerate(instance_);
+        if (devices.empty()) throw NoDeviceError(std::string("no Vulkan device found: ") + kInstallHint);
+        int best = -1, bestRank = -1;
+        std::vector<std::uint32_t> families(devices.size());
+        for (std::size_t i = 0; i < devices.size(); ++i) {
+            reports_.push_back(examine(devices[i], static_cast<int>(i), families[i], options.deviceExtensions));
+            VkPhysicalDeviceProperties props;
+            vkGetPhysicalDeviceProperties(devices[i], &props);
+            if (options.deviceIndex >= 0) {
+                if (static_cast<int>(i) != options.deviceIndex && reports_.back().usable)
+                    reports_.back().reason = "not the device asked for (--gpu " + std::to_string(options.deviceIndex) + ")";
+                continue;
+            }
+            if (reports_.back().usable && typeRank(props.deviceType) > bestRank) {
+                best = static_cast<int>(i);
+                bestRank = typeRank(props.deviceType);
+            }
+        }
+        if (options.deviceIndex >= 0) {
+            if (options.deviceIndex >= static_cast<int>(devices.size()))
+                throw NoDeviceError("--gpu " + std::to_string(options.deviceIndex) + ": there are only " +
+                                    std::to_string(devices.size()) + " Vulkan device(s); see 'snell devices'");
+            if (!reports_[options.deviceIndex].usable)
+                throw NoDeviceError("device " + std::to_string(options.deviceIndex) + " (" +
+                                    reports_[options.deviceIndex].name + ") cannot be used: " +
+                                    reports_[options.deviceIndex].reason);
+            best = options.deviceIndex;
+        }
+        if (best < 0) {
+            std::string why = "no usable Vulkan device:";
+            for (const DeviceReport& r : reports_) why += "\n  device " + std::to_string(r.index) + " " + r.name + ": " + r.reason;
+            throw NoDeviceError(why + "\n" + kInstallHint);
+        }
+        for (DeviceReport& r : reports_)
+            if (r.index != best && r.usable && r.reason.empty()) r.reason = "a device of a preferred type was chosen";
+        physical_ = devices[best];
+        queueFamily_ = families[best];
+        deviceName_ = reports_[best].name;
+        driverInfo_ = reports_[best].driver;
+        vkGetPhysicalDeviceProperties(physical_, &properties_);
+        vkGetPhysicalDeviceMemoryProperties(physical_, &memory_);
+        std::uint32_t count = 0;
+        vkGetPhysicalDeviceQueueFamilyProperties(physical_, &count, nullptr);
+        std::vector<VkQueueFamilyProperties> qf(count);
+        vkGetPhysicalDeviceQueueFamilyProperties(physical_, &count, qf.data());
+        timestampValidBits_ = qf[queueFamily_].timestampValidBits;
+
+        VkPhysicalDeviceFeatures supported;
+        vkGetPhysicalDeviceFeatures(physical_, &supported);
+        VkPhysicalDeviceFeatures enabled{};
+        float64_ = supported.shaderFloat64;
+        enabled.shaderFloat64 = supported.shaderFloat64;
+        const float priority = 1.0f;
+        VkDeviceQueueCreateInfo queueInfo{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
+        queueInfo.queueFamilyIndex = queueFamily_;
+        queueInfo.queueCount = 1;
+        queueInfo.pQueuePriorities = &priority;
+        std::vector<const char*> exts;
+        for (const std::string& e : options.deviceExtensions) exts.push_back(e.c_str());
+        VkDeviceCreateInfo info{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
+        info.queueCreateInfoCount = 1;
+        info.pQueueCreateInfos = &queueInfo;
+        info.pEnabledFeatures = &enabled;
+        info.enabledExtensionCount = static_cast<std::uint32_t>(exts.size());
+        info.ppEnabledExtensionNames = exts.data();
+        check(vkCreateDevice(physical_, &info, nullptr, &device_), "vkCreateDevice");
+        vkGetDeviceQueue(device_, queueFamily_, 0, &queue_);
+        VkCommandPoolCreateInfo poolInfo{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+        poolInfo.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+        poolInfo.queueFamilyIndex = queueFamily_;
+        check(vkCreateCommandPool(device_, &poolInfo, nullptr, &pool_), "vkCreateCommandPool");
+        VkFenceCreateInfo fenceInfo{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+        check(vkCreateFence(device_, &fenceInfo, nullptr, &fence_), "vkCreateFence");
+    } catch (...) {
+        release();
+        throw;
+    }
+}
+
+Context::~Context() { release(); }
+
+void Context::release() {
+    if (device_) {
+        vkDeviceWaitIdle(device_);
+        if (fence_) vkDestroyFence(device_, fence_, nullptr);
+        if (pool_) vkDestroyCommandPool(device_, pool_, nullptr);
+        vkDestroyDevice(device_, nullptr);
+        device_ = VK_NULL_HANDLE;
+        fence_ = VK_NULL_HANDLE;
+        pool_ = VK_NULL_HANDLE;
+    }
+    if (messenger_) {
+        auto destroy = reinterpret_cast<PFN_vkDestroyDebugUtilsMessengerEXT>(
+            vkGetInstanceProcAddr(instance_, "vkDestroyDebugUtilsMessengerEXT"));
+        if (destroy) destroy(instance_, messenger_, nullptr);
+        messenger_ = VK_NULL_HANDLE;
+    }
+    if (instance_) {
+        vkDestroyInstance(instance_, nullptr);
+        instance_ = VK_NULL_HANDLE;
+    }
+}
+
+VKAPI_ATTR VkBool32 VKAPI_CALL Context::debugCallback(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
+                                                      VkDebugUtilsMessageTypeFlagsEXT,
+                                                      const VkDebugUtilsMessengerCallbackDataEXT* data, void* user) {
+    auto* self = static_cast<Context*>(user);
+    ++self->validationMessages_;
+    std::fprintf(stderr, "snell: validation %s: %s\n",
+                 severity >= VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT ? "error" : "warning",
+                 data && data->pMessage ? data->pMessage : "(no message)");
+    return VK_FALSE;
+}
+
+std::uint32_t Context::findMemoryType(std::uint32_t typeBits, VkMemoryPropertyFlags required,
+                                      VkMemoryPropertyFlags preferred) const {
+    for (VkMemoryPropertyFlags want : {required | preferred, required}) {
+        for (std::uint32_t i = 0; i < memory_.memoryTypeCount; ++i) {
+            if ((typeBits & (1u << i)) && (memory_.memoryTypes[i].propertyFlags & want) == want) return i;
+        }
+    }
+    throw VulkanError("no suitable Vulkan memory type for a buffer or image");
+}
+
+Buffer Context::createBuffer(VkDeviceSize size, VkBufferUsageFlags usage, bool hostVisible) {
+    Buffer b;
+    b.size = std::max<VkDeviceSize>(size, 16);  // zero-sized buffers are invalid in Vulkan
+    VkBufferCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
+    info.size = b.size;
+    info.usage = usage;
+    info.sharingMode = VK_SHARING_MODE_EXCLUSIVE;
+    check(vkCreateBuffer(device_, &info, nullptr, &b.buffer), "vkCreateBuffer");
+    VkMemoryRequirements req;
+    vkGetBufferMemoryRequirements(device_, b.buffer, &req);
+    VkMemoryAllocateInfo alloc{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+    alloc.allocationSize = req.size;
+    try {
+        alloc.memoryTypeIndex = hostVisible
+            ? findMemoryType(req.memoryTypeBits, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT,
+                             VK_MEMORY_PROPERTY_HOST_CACHED_BIT)
+            : findMemoryType(req.memoryTypeBits, 0, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+        check(vkAllocateMemory(device_, &alloc, nullptr, &b.memory), "vkAllocateMemory");
+        check(vkBindBufferMemory(device_, b.buffer, b.memory, 0), "vkBindBufferMemory");
+        if (hostVisible) check(vkMapMemory(device_, b.memory, 0, VK_WHOLE_SIZE, 0, &b.mapped), "vkMapMemory");
+    } catch (...) {
+        destroy(b);
+        throw;
+    }
+    return b;
+}
+
+Buffer Context::createBufferWithData(const void* bytes, VkDeviceSize size, VkBufferUsageFlags usage) {
+    Buffer target = createBuffer(size, usage | VK_BUFFER_USAGE_TRANSFER_DST_BIT, false);
+    if (size == 0) return target;
+    // Device-local memory that the host can see (lavapipe, integrated GPUs, ReBAR) is written directly.
+    VkMemoryRequirements req;
+    vkGetBufferMemoryRequirements(device_, target.buffer, &req);
+    bool direct = false;
+    for (std::uint32_t i = 0; i < memory_.memoryTypeCount; ++i) {
+        // findMemoryType picked the first device-local type this buffer allows.
+        if ((req.memoryTypeBits & (1u << i)) && (memory_.memoryTypes[i].propertyFlags & VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT)) {
+            direct = (memory_.memoryTypes[i].propertyFlags & (VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT)) ==
+                     (VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
+            break;
+        }
+    }
+    if (direct) {
+        void* p = nullptr;
+        check(vkMapMemory(device_, target.memory, 0, VK_WHOLE_SIZE, 0, &p), "vkMapMemory");
+        std::memcpy(p, bytes, size);
+        vkUnmapMemory(device_, target.memory);
+        return target;
+    }
+    Buffer staging = createBuffer(size, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true);
+    std::memcpy(staging.mapped, bytes, size);
+    try {
+        submitAndWait([&](VkCommandBuffer cmd) {
+            VkBufferCopy region{0, 0, size};
+            vkCmdCopyBuffer(cmd, staging.buffer, target.buffer, 1, &region);
+        });
+    } catch (...) {
+        destroy(staging);
+        destroy(target);
+        throw;
+    }
+    destroy(staging);
+    return target;
+}
+
+void Context::destroy(Buffer& b) {
+    if (b.buffer) vkDestroyBuffer(device_, b.buffer, nullptr);
+    if (b.memory) vkFreeMemory(device_, b.memory, nullptr);
+    b = Buffer{};
+}
+
+StorageImage Context::createStorageImage(std::uint32_t width, std::uint32_t height, VkFormat format) {
+    StorageImage img;
+    img.width = width;
+    img.height = height;
+    VkImageCreateInfo info{VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO};
+    info.imageType = VK_IMAGE_TYPE_2D;
+    info.format = format;
+    info.extent = {width, height, 1};
+    info.mipLevels = 1;
+    info.arrayLayers = 1;
+    info.samples = VK_SAMPLE_COUNT_1_BIT;
+    info.tiling = VK_IMAGE_TILING_OPTIMAL;
+    info.usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
+    info.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
+    try {
+        check(vkCreateImage(device_, &info, nullptr, &img.image), "vkCreateImage");
+        VkMemoryRequirements req;
+        vkGetImageMemoryRequirements(device_, img.image, &req);
+        VkMemoryAllocateInfo alloc{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+        alloc.allocationSize = req.size;
+        alloc.memoryTypeIndex = findMemoryType(req.memoryTypeBits, 0, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
+        check(vkAllocateMemory(device_, &alloc, nullptr, &img.memory), "vkAllocateMemory");
+        check(vkBindImageMemory(device_, img.image, img.memory, 0), "vkBindImageMemory");
+        VkImageViewCreateInfo view{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
+        view.image = img.image;
+        view.viewType = VK_IMAGE_VIEW_TYPE_2D;
+        view.format = format;
+        view.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+        check(vkCreateImageView(device_, &view, nullptr, &img.view), "vkCreateImageView");
+    } catch (...) {
+        destroy(img);
+        throw;
+    }
+    return img;
+}
+
+void Context::destroy(StorageImage& img) {
+    if (img.view) vkDestroyImageView(device_, img.view, nullptr);
+    if (img.image) vkDestroyImage(device_, img.image, nullptr);
+    if (img.memory) vkFreeMemory(device_, img.memory, nullptr);
+    img = StorageImage{};
+}
+
+VkCommandBuffer Context::beginOneOff() {
+    VkCommandBufferAllocateInfo alloc{VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO};
+    alloc.commandPool = pool_;
+    alloc.level = VK_COMMAND_BUFFER_LEVEL_PRIMARY;
+    alloc.commandBufferCount = 1;
+    VkCommandBuffer cmd;
+    check(vkAllocateCommandBuffers(device_, &alloc, &cmd), "vkAllocateCommandBuffers");
+    VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+    begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+    const VkResult r = vkBeginCommandBuffer(cmd, &begin);
+    if (r != VK_SUCCESS) vkFreeCommandBuffers(device_, pool_, 1, &cmd);
+    check(r, "vkBeginCommandBuffer");
+    return cmd;
+}
+
+void Context::endOneOffAndWait(VkCommandBuffer cmd) {
+    VkResult r = vkEndCommandBuffer(cmd);
+    if (r == VK_SUCCESS) {
+        VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+        submit.commandBufferCount = 1;
+        submit.pCommandBuffers = &cmd;
+        r = vkQueueSubmit(queue_, 1, &submit, fence_);
+        if (r == VK_SUCCESS) {
+            r = vkWaitForFences(device_, 1, &fence_, VK_TRUE, UINT64_MAX);
+            const VkResult reset = vkResetFences(device_, 1, &fence_);
+            if (r == VK_SUCCESS) r = reset;
+        }
+    }
+    vkFreeCommandBuffers(device_, pool_, 1, &cmd);
+    check(r, "vkQueueSubmit/vkWaitForFences");
+}
+
+}  // namespace snell::vk

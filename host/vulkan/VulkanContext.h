@@ -1,0 +1,138 @@
+// A small, honest Vulkan setup: instance, one physical device chosen with the
+// reasons each other one was passed over, one compute queue, and buffer/image
+// helpers. Every VkResult goes through check(), which throws VulkanError with
+// a message a user can act on.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <vulkan/vulkan.h>
+
+namespace snell::vk {
+
+class VulkanError : public std::runtime_error {
+public:
+    VulkanError(const std::string& message, VkResult result = VK_SUCCESS)
+        : std::runtime_error(message), result_(result) {}
+    VkResult result() const { return result_; }
+
+private:
+    VkResult result_;
+};
+
+// No usable Vulkan device (or no Vulkan at all): tells what to install.
+class NoDeviceError : public VulkanError {
+public:
+    using VulkanError::VulkanError;
+};
+
+const char* resultName(VkResult result);
+void check(VkResult result, const char* call);
+#define SNELL_VK_CHECK(call) ::snell::vk::check((call), #call)
+
+struct ContextOptions {
+    int deviceIndex = -1;         // -1: choose (discrete GPU first); else this index
+    bool validation = false;      // enable VK_LAYER_KHRONOS_validation
+    std::vector<std::string> instanceExtensions;  // e.g. what GLFW needs
+    std::vector<std::string> deviceExtensions;
+};
+
+struct DeviceReport {
+    int index = 0;
+    std::string name;
+    std::string type;
+    std::string driver;
+    bool usable = false;
+    std::string reason;  // why it was passed over, when it was
+};
+
+struct Buffer {
+    VkBuffer buffer = VK_NULL_HANDLE;
+    VkDeviceMemory memory = VK_NULL_HANDLE;
+    VkDeviceSize size = 0;
+    void* mapped = nullptr;  // host-visible buffers stay mapped
+};
+
+struct StorageImage {
+    VkImage image = VK_NULL_HANDLE;
+    VkDeviceMemory memory = VK_NULL_HANDLE;
+    VkImageView view = VK_NULL_HANDLE;
+    std::uint32_t width = 0, height = 0;
+};
+
+class Context {
+public:
+    // Throws NoDeviceError when no device fits, VulkanError on other failures.
+    explicit Context(const ContextOptions& options = {});
+    ~Context();
+    Context(const Context&) = delete;
+    Context& operator=(const Context&) = delete;
+
+    VkInstance instance() const { return instance_; }
+    VkPhysicalDevice physicalDevice() const { return physical_; }
+    VkDevice device() const { return device_; }
+    VkQueue queue() const { return queue_; }
+    std::uint32_t queueFamily() const { return queueFamily_; }
+    const VkPhysicalDeviceProperties& properties() const { return properties_; }
+    const std::string& deviceName() const { return deviceName_; }
+    const std::string& driverInfo() const { return driverInfo_; }
+    bool timestampsSupported() const { return timestampValidBits_ > 0 && properties_.limits.timestampComputeAndGraphics; }
+    bool float64Supported() const { return float64_; }
+    // Validation-layer errors and warnings reported so far.
+    std::uint32_t validationMessages() const { return validationMessages_; }
+    const std::vector<DeviceReport>& deviceReports() const { return reports_; }
+
+    // Device-local when possible; host-visible (and mapped) when asked.
+    Buffer createBuffer(VkDeviceSize size, VkBufferUsageFlags usage, bool hostVisible);
+    // A device-local buffer holding `bytes` (staged through a host buffer when
+    // device-local memory is not host-visible).
+    Buffer createBufferWithData(const void* bytes, VkDeviceSize size, VkBufferUsageFlags usage);
+    void destroy(Buffer& buffer);
+    StorageImage createStorageImage(std::uint32_t width, std::uint32_t height, VkFormat format);
+    void destroy(StorageImage& image);
+
+    // Record and run a one-off command buffer, waiting for it to finish.
+    template <typename Record>
+    void submitAndWait(Record record) {
+        VkCommandBuffer cmd = beginOneOff();
+        record(cmd);
+        endOneOffAndWait(cmd);
+    }
+
+    // Every available device with why it would or would not be used.
+    static std::vector<DeviceReport> listDevices();
+
+private:
+    std::uint32_t findMemoryType(std::uint32_t typeBits, VkMemoryPropertyFlags required,
+                                 VkMemoryPropertyFlags preferred) const;
+    void release();
+    VkCommandBuffer beginOneOff();
+    void endOneOffAndWait(VkCommandBuffer cmd);
+    static VKAPI_ATTR VkBool32 VKAPI_CALL debugCallback(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
+                                                        VkDebugUtilsMessageTypeFlagsEXT types,
+                                                        const VkDebugUtilsMessengerCallbackDataEXT* data,
+                                                        void* user);
+
+    VkInstance instance_ = VK_NULL_HANDLE;
+    VkDebugUtilsMessengerEXT messenger_ = VK_NULL_HANDLE;
+    VkPhysicalDevice physical_ = VK_NULL_HANDLE;
+    VkDevice device_ = VK_NULL_HANDLE;
+    VkQueue queue_ = VK_NULL_HANDLE;
+    VkCommandPool pool_ = VK_NULL_HANDLE;
+    VkFence fence_ = VK_NULL_HANDLE;
+    std::uint32_t queueFamily_ = 0;
+    std::uint32_t timestampValidBits_ = 0;
+    bool float64_ = false;
+    VkPhysicalDeviceProperties properties_{};
+    VkPhysicalDeviceMemoryProperties memory_{};
+    std::string deviceName_;
+    std::string driverInfo_;
+    std::vector<DeviceReport> reports_;
+    std::uint32_t validationMessages_ = 0;
+};
+
+}  // namespace snell::vk

@@ -1,0 +1,9 @@
+#!/usr/bin/env bash
+# Quick start 2: set up, build, and run the whole test suite (ctest).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash scripts/setup.sh
+# The Khronos validation layer watches the GPU tests; any message fails them.
+export SNELL_VALIDATION=1
+cd build
+ctest --output-on-failure --timeout 900 "$@"

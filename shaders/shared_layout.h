@@ -1,0 +1,132 @@
+// The one declaration of everything the host and the compute shader share:
+// binding numbers, workgroup size, specialization-constant ids and the std430
+// structs of the scene buffers. Included by C++ (host/gpu/GpuScene.h) and by
+// GLSL (shaders/trace.comp). Members are vec4, mat4 or uint only, so std430 and
+// C++ agree without padding rules; host/gpu/GpuScene.h static_asserts sizes.
+#ifndef SNELL_SHARED_LAYOUT_H
+#define SNELL_SHARED_LAYOUT_H
+
+#ifdef __cplusplus
+#include <cstdint>
+#include <glm/glm.hpp>
+namespace snell::gpu {
+using vec4 = glm::vec4;
+using mat4 = glm::mat4;
+using uint = std::uint32_t;
+#define SNELL_CONST constexpr std::uint32_t
+#else
+#define SNELL_CONST const uint
+#endif
+
+// Workgroup: 8x8 pixels, one invocation per pixel.
+#define SNELL_WORKGROUP_SIZE_X 8
+#define SNELL_WORKGROUP_SIZE_Y 8
+
+// Descriptor set 0.
+#define SNELL_BINDING_OUTPUT_IMAGE 0
+#define SNELL_BINDING_FRAME 1
+#define SNELL_BINDING_SPHERES 2
+#define SNELL_BINDING_ELLIPSOIDS 3
+#define SNELL_BINDING_MATERIALS 4
+#define SNELL_BINDING_LIGHTS 5
+#define SNELL_BINDING_BVH 6
+#define SNELL_BINDING_COUNTERS 7
+
+// Specialization constants: compile only what a scene uses.
+#define SNELL_SPEC_USE_BVH 0
+#define SNELL_SPEC_HAS_ELLIPSOIDS 1
+#define SNELL_SPEC_HAS_REFRACTION 2
+#define SNELL_SPEC_HAS_REFLECTION 3
+#define SNELL_SPEC_HAS_LIGHTS 4
+#define SNELL_SPEC_COUNT_RAYS 5
+#define SNELL_SPEC_MAX_MEDIA 6
+#define SNELL_SPEC_RAY_STACK 7
+#define SNELL_SPEC_AMPLIFYING 8
+
+// Sphere::ellipsoid when the sphere is a true sphere (centre + radius).
+#define SNELL_NOT_ELLIPSOID 0xffffffffu
+// Ray-counter slots in the counters buffer.
+#define SNELL_COUNTER_PRIMARY 0
+#define SNELL_COUNTER_SHADOW 1
+#define SNELL_COUNTER_REFLECTED 2
+#define SNELL_COUNTER_REFRACTED 3
+#define SNELL_COUNTER_COUNT 4
+
+// Hard upper bounds of the shader's fixed-size arrays.
+#define SNELL_MAX_MEDIA_LIMIT 16
+#define SNELL_BVH_STACK 48
+
+// One primitive. Coordinates are camera-relative (world minus eye), prepared
+// in double on the host. For a true sphere centreRadius is (centre, radius);
+// for an ellipsoid it is a bounding sphere and `ellipsoid` indexes Ellipsoid.
+struct Sphere {
+    vec4 centreRadius;
+    uint material;
+    uint ellipsoid;
+    uint pad0;
+    uint pad1;
+};
+
+// A sphere whose transform is not a similarity: the unit sphere seen through
+// objectFromWorld (camera-relative world -> object). Its normal matrix is the
+// transpose of objectFromWorld's linear part (SPEC §4.2: M^-T).
+struct Ellipsoid {
+    mat4 objectFromWorld;
+};
+
+// SPEC §2/§4 material: kd.w is the Phong exponent, kt.w the index of refraction.
+struct Material {
+    vec4 kd;
+    vec4 ks;
+    vec4 kt;
+};
+
+struct Light {
+    vec4 position;  // camera-relative, w unused
+    vec4 colour;    // rgb, w unused
+};
+
+// BVH node (host/bvh/Bvh.h): an inner node has count == 0 and its children at
+// first and first + 1; a leaf holds spheres [first, first + count).
+struct BvhNode {
+    vec4 lower;
+    vec4 upper;
+    uint first;
+    uint count;
+    uint pad0;
+    uint pad1;
+};
+
+// Per-render parameters (uniform buffer). The primary ray through the image
+// point with pixel coordinates (x, y) has direction
+//   normalize(cornerDir + x * pixelRight + y * pixelDown)       (SPEC §3)
+// from the camera origin, which is the coordinate origin (camera-relative).
+struct FrameParams {
+    vec4 cornerDir;     // xyz: image-plane corner (pixel coords 0,0) minus eye
+    vec4 pixelRight;    // xyz: one pixel step along a row
+    vec4 pixelDown;     // xyz: one pixel step down a column
+    vec4 background;    // rgb background, w = eta of air
+    vec4 ambient;       // rgb ambient, w = minimum ray weight
+    uint imageWidth;
+    uint imageHeight;
+    uint supersample;
+    uint maxDepth;
+    uint sphereCount;
+    uint lightCount;
+    uint bvhNodeCount;
+    uint pad0;
+};
+
+// Push constants: the tile of the image this dispatch covers.
+struct TileParams {
+    uint originX;
+    uint originY;
+    uint width;
+    uint height;
+};
+
+#ifdef __cplusplus
+}  // namespace snell::gpu
+#endif
+#undef SNELL_CONST
+#endif

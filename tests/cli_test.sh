@@ -1,0 +1,63 @@
+#!/usr/bin/env bash
+# The command line as a user meets it: exit statuses, the FILE:LINE:COL error
+# format, --help/--version, --stats JSON, and that a failed render never
+# writes, truncates or clobbers an output file.
+set -u
+: "${SNELL:?}" "${SCENES:?}"
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+pass=0 fail=0
+ok() { pass=$((pass + 1)); }
+bad() { echo "FAIL: $*"; fail=$((fail + 1)); }
+
+# --help and --version
+"$SNELL" --help >"$work/help" 2>&1 && grep -q "render" "$work/help" && grep -q "Exit status" "$work/help" && ok || bad "--help"
+"$SNELL" render --help >"$work/rhelp" 2>&1 && grep -q -- "--stats" "$work/rhelp" && ok || bad "render --help"
+"$SNELL" --version >"$work/version" 2>&1 && grep -q "^snell [0-9]" "$work/version" && ok || bad "--version"
+
+# A scene error: status 2, FILE:LINE:COL message, existing output untouched.
+printf 'view 16 0.5\nsphere\nscale 1 0 1\n' >"$work/bad.scn"
+echo "precious" >"$work/out.png"
+"$SNELL" render "$work/bad.scn" -o "$work/out.png" 2>"$work/err"; status=$?
+[ $status -eq 2 ] && ok || bad "scene error exit status $status (want 2)"
+grep -q "^$work/bad.scn:3:9: error: " "$work/err" && ok || bad "error format: $(cat "$work/err")"
+[ "$(cat "$work/out.png")" = "precious" ] && ok || bad "output clobbered by a failed render"
+[ -z "$(ls "$work" | grep tmp)" ] && ok || bad "temporary file left behind"
+
+# Missing file and directory as input: status 2 with a located message.
+"$SNELL" render "$work/nope.scn" -o "$work/x.png" 2>"$work/err"; status=$?
+[ $status -eq 2 ] && grep -q "nope.scn:1:1: error:" "$work/err" && [ ! -e "$work/x.png" ] && ok || bad "missing file ($status)"
+"$SNELL" render "$work" -o "$work/x.png" 2>"$work/err"; status=$?
+[ $status -eq 2 ] && grep -q "directory" "$work/err" && ok || bad "directory as input ($status)"
+
+# Bad command line: status 2. Unknown output format / unwritable dir: status 1 before rendering.
+"$SNELL" render "$SCENES/basic.scn" --size 0 -o "$work/x.png" 2>/dev/null; [ $? -eq 2 ] && ok || bad "--size 0"
+"$SNELL" render "$SCENES/basic.scn" -o "$work/x.jpg" 2>"$work/err"; status=$?
+[ $status -eq 1 ] && grep -q ".png, .ppm or .pfm" "$work/err" && ok || bad "unknown extension ($status)"
+"$SNELL" render "$SCENES/basic.scn" -o "$work/no/such/dir/x.png" 2>"$work/err"; status=$?
+[ $status -eq 1 ] && grep -q "does not exist" "$work/err" && ok || bad "missing output dir ($status)"
+
+# A good render in every format, with --stats as the last line of stdout.
+for ext in png ppm pfm; do
+  "$SNELL" render "$SCENES/basic.scn" --size 32 -o "$work/basic.$ext" --stats >"$work/stats" 2>"$work/err"; status=$?
+  [ $status -eq 0 ] && [ -s "$work/basic.$ext" ] && ok || bad "render .$ext ($status): $(cat "$work/err")"
+done
+tail -n 1 "$work/stats" | python3 -c '
+import json, sys
+d = json.loads(sys.stdin.read())
+for k in ("parse_ms", "upload_ms", "render_ms", "readback_ms", "write_ms", "total_ms", "device"):
+    assert k in d, k
+for k in ("primary", "shadow", "reflected", "refracted"):
+    assert k in d["rays"], k
+assert d["rays"]["primary"] == 32 * 32, d["rays"]
+assert d["width"] == 32
+' && ok || bad "--stats JSON"
+head -c 2 "$work/basic.ppm" | grep -q P6 && ok || bad "PPM magic"
+head -c 2 "$work/basic.pfm" | grep -q PF && ok || bad "PFM magic"
+
+# The CPU back end renders the same scene, and compare agrees with itself.
+"$SNELL" render "$SCENES/basic.scn" --size 32 --cpu -o "$work/cpu.png" 2>/dev/null && ok || bad "--cpu"
+"$SNELL" compare "$work/basic.png" "$work/cpu.png" >"$work/cmp" && grep -q mean_abs_error "$work/cmp" && ok || bad "compare"
+
+echo "cli: $pass passed, $fail failed"
+[ $fail -eq 0 ]

@@ -1,0 +1,250 @@
+// The std430 layout shared with the shader (shaders/shared_layout.h), checked
+// at run time so that a mismatch shows up in ctest, and buildGpuScene.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstddef>
+#include <set>
+#include <vector>
+
+#include "gpu/GpuScene.h"
+#include "scene/Parser.h"
+
+namespace {
+
+namespace gpu = snell::gpu;
+
+TEST(Layout, Sphere) {
+    EXPECT_EQ(sizeof(gpu::Sphere), 32u);
+    EXPECT_EQ(offsetof(gpu::Sphere, centreRadius), 0u);
+    EXPECT_EQ(offsetof(gpu::Sphere, material), 16u);
+    EXPECT_EQ(offsetof(gpu::Sphere, ellipsoid), 20u);
+    EXPECT_EQ(offsetof(gpu::Sphere, pad0), 24u);
+    EXPECT_EQ(offsetof(gpu::Sphere, pad1), 28u);
+}
+
+TEST(Layout, Ellipsoid) {
+    EXPECT_EQ(sizeof(gpu::Ellipsoid), 64u);
+    EXPECT_EQ(offsetof(gpu::Ellipsoid, objectFromWorld), 0u);
+    EXPECT_EQ(sizeof(gpu::mat4), 64u);
+}
+
+TEST(Layout, Material) {
+    EXPECT_EQ(sizeof(gpu::Material), 48u);
+    EXPECT_EQ(offsetof(gpu::Material, kd), 0u);
+    EXPECT_EQ(offsetof(gpu::Material, ks), 16u);
+    EXPECT_EQ(offsetof(gpu::Material, kt), 32u);
+}
+
+TEST(Layout, Light) {
+    EXPECT_EQ(sizeof(gpu::Light), 32u);
+    EXPECT_EQ(offsetof(gpu::Light, position), 0u);
+    EXPECT_EQ(offsetof(gpu::Light, colour), 16u);
+}
+
+TEST(Layout, BvhNode) {
+    EXPECT_EQ(sizeof(gpu::BvhNode), 48u);
+    EXPECT_EQ(offsetof(gpu::BvhNode, lower), 0u);
+    EXPECT_EQ(offsetof(gpu::BvhNode, upper), 16u);
+    EXPECT_EQ(offsetof(gpu::BvhNode, first), 32u);
+    EXPECT_EQ(offsetof(gpu::BvhNode, count), 36u);
+    EXPECT_EQ(offsetof(gpu::BvhNode, pad0), 40u);
+    EXPECT_EQ(offsetof(gpu::BvhNode, pad1), 44u);
+}
+
+TEST(Layout, FrameParams) {
+    EXPECT_EQ(sizeof(gpu::FrameParams), 112u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, cornerDir), 0u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, pixelRight), 16u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, pixelDown), 32u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, background), 48u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, ambient), 64u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, imageWidth), 80u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, imageHeight), 84u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, supersample), 88u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, maxDepth), 92u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, sphereCount), 96u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, lightCount), 100u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, bvhNodeCount), 104u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, pad0), 108u);
+}
+
+TEST(Layout, TileParams) {
+    EXPECT_EQ(sizeof(gpu::TileParams), 16u);
+    EXPECT_EQ(offsetof(gpu::TileParams, originX), 0u);
+    EXPECT_EQ(offsetof(gpu::TileParams, originY), 4u);
+    EXPECT_EQ(offsetof(gpu::TileParams, width), 8u);
+    EXPECT_EQ(offsetof(gpu::TileParams, height), 12u);
+}
+
+TEST(Layout, ArrayStridesAreVec4Multiples) {
+    // std430 arrays of structs containing vec4 have a stride that is a multiple of 16.
+    EXPECT_EQ(sizeof(gpu::Sphere) % 16, 0u);
+    EXPECT_EQ(sizeof(gpu::Ellipsoid) % 16, 0u);
+    EXPECT_EQ(sizeof(gpu::Material) % 16, 0u);
+    EXPECT_EQ(sizeof(gpu::Light) % 16, 0u);
+    EXPECT_EQ(sizeof(gpu::BvhNode) % 16, 0u);
+    EXPECT_EQ(sizeof(gpu::vec4), 16u);
+    EXPECT_EQ(sizeof(gpu::uint), 4u);
+    EXPECT_EQ(SNELL_NOT_ELLIPSOID, 0xffffffffu);
+}
+
+// ---------------------------------------------------------------- buildGpuScene
+
+snell::Scene parse(const std::string& text) { return snell::parseScene(text, "t.scn"); }
+
+void expectVec(const glm::vec4& v, float x, float y, float z, float w) {
+    EXPECT_FLOAT_EQ(v.x, x);
+    EXPECT_FLOAT_EQ(v.y, y);
+    EXPECT_FLOAT_EQ(v.z, z);
+    EXPECT_FLOAT_EQ(v.w, w);
+}
+
+TEST(GpuScene, SmallSceneIsCameraRelativeAndClassified) {
+    const snell::Scene s = parse("view 10 1\nmove 1 2 3\ngroup\nmaterial 0.1 0.2 0.3 0.4 0.5 0.6 7\n"
+                                 "refraction 0.5 0.5 0.5 1.5\nscale 2 2 2\nsphere\ngroupend\n"
+                                 "scale 1 2 1\nsphere\nlight 0.7 0.8 0.9 4 5 6\n");
+    const snell::Camera camera = snell::Camera::fromSpec(s.imageSize, s.halfWidth);
+    const gpu::GpuScene g = gpu::buildGpuScene(s, camera);
+    EXPECT_EQ(g.eye, snell::dvec3(0, 0, 1));
+    ASSERT_EQ(g.spheres.size(), 2u);
+    EXPECT_TRUE(g.nodes.empty());  // 2 spheres: no BVH, order kept
+
+    // True sphere: centre (1,2,3) minus eye (0,0,1), radius 2.
+    expectVec(g.spheres[0].centreRadius, 1, 2, 2, 2);
+    EXPECT_EQ(g.spheres[0].ellipsoid, SNELL_NOT_ELLIPSOID);
+    // Ellipsoid: its bounding sphere's centre is camera-relative too.
+    EXPECT_NE(g.spheres[1].ellipsoid, SNELL_NOT_ELLIPSOID);
+    ASSERT_EQ(g.ellipsoids.size(), 1u);
+    EXPECT_EQ(g.spheres[1].ellipsoid, 0u);
+    EXPECT_FLOAT_EQ(g.spheres[1].centreRadius.x, 1);
+    EXPECT_FLOAT_EQ(g.spheres[1].centreRadius.y, 2);
+    EXPECT_FLOAT_EQ(g.spheres[1].centreRadius.z, 2);
+    EXPECT_GE(g.spheres[1].centreRadius.w, 2.0f);
+    // Its matrix maps camera-relative points to object space: the world point
+    // (1, 4, 3) = top of the ellipsoid is (1, 4, 2) relative to the eye.
+    const glm::vec4 top = g.ellipsoids[0].objectFromWorld * glm::vec4(1, 4, 2, 1);
+    EXPECT_NEAR(top.x, 0.0f, 1e-6f);
+    EXPECT_NEAR(top.y, 1.0f, 1e-6f);
+    EXPECT_NEAR(top.z, 0.0f, 1e-6f);
+    const glm::vec4 centre = g.ellipsoids[0].objectFromWorld * glm::vec4(1, 2, 2, 1);
+    EXPECT_NEAR(glm::length(glm::vec3(centre)), 0.0f, 1e-6f);
+
+    // Materials and lights.
+    ASSERT_EQ(g.materials.size(), s.materials.size());
+    const gpu::Material& glass = g.materials[g.spheres[0].material];
+    expectVec(glass.kd, 0.1f, 0.2f, 0.3f, 7.0f);  // w = Phong exponent
+    EXPECT_FLOAT_EQ(glass.ks.y, 0.5f);
+    expectVec(glass.kt, 0.5f, 0.5f, 0.5f, 1.5f);  // w = eta
+    const gpu::Material& plain = g.materials[g.spheres[1].material];
+    expectVec(plain.kd, 1, 1, 1, 1);
+    EXPECT_FLOAT_EQ(plain.kt.w, static_cast<float>(snell::kAirEta));
+    EXPECT_EQ(g.refractiveSpheres, 1u);
+    EXPECT_FALSE(g.amplifying);
+    ASSERT_EQ(g.lights.size(), 1u);
+    EXPECT_FLOAT_EQ(g.lights[0].position.x, 4);
+    EXPECT_FLOAT_EQ(g.lights[0].position.y, 5);
+    EXPECT_FLOAT_EQ(g.lights[0].position.z, 5);  // 6 - 1
+    EXPECT_FLOAT_EQ(g.lights[0].colour.r, 0.7f);
+    EXPECT_FLOAT_EQ(g.lights[0].colour.b, 0.9f);
+
+    const gpu::FrameParams f = gpu::makeFrameParams(s, g, camera, 10, 10, 1, 32, 1e-4);
+    EXPECT_EQ(f.sphereCount, 2u);
+    EXPECT_EQ(f.lightCount, 1u);
+    EXPECT_EQ(f.bvhNodeCount, 0u);
+    EXPECT_EQ(f.imageWidth, 10u);
+    EXPECT_FLOAT_EQ(f.cornerDir.x, -1.0f);
+    EXPECT_FLOAT_EQ(f.cornerDir.y, 1.0f);
+    EXPECT_FLOAT_EQ(f.cornerDir.z, -1.0f);
+    EXPECT_FLOAT_EQ(f.pixelRight.x, 0.2f);
+    EXPECT_FLOAT_EQ(f.pixelDown.y, -0.2f);
+}
+
+TEST(GpuScene, AmplifyingMaterialFlagged) {
+    const snell::Scene s = parse("view 10 1\nmaterial 1 1 1 0.5 0.5 0.5 1\nrefraction 1 1 1 1.5\nsphere\n");
+    EXPECT_TRUE(gpu::buildGpuScene(s, snell::Camera::fromSpec(10, 1)).amplifying);
+}
+
+// `count` spheres at x = 3, 6, 9, ... (unique, camera-relative x unchanged);
+// every third one an ellipsoid.
+std::string rowOfSpheres(std::size_t count) {
+    std::string text = "view 10 1\n";
+    for (std::size_t i = 0; i < count; ++i) {
+        text += "move 3 0 0\n";
+        text += (i % 3 == 2) ? "group\nscale 1 0.5 1\nsphere\ngroupend\n" : "sphere\n";
+    }
+    return text;
+}
+
+TEST(GpuScene, NoBvhAtTheThreshold) {
+    const snell::Scene s = parse(rowOfSpheres(gpu::kBvhThreshold));
+    const gpu::GpuScene g = gpu::buildGpuScene(s, snell::Camera::fromSpec(10, 1));
+    EXPECT_TRUE(g.nodes.empty());
+    ASSERT_EQ(g.spheres.size(), gpu::kBvhThreshold);
+    for (std::size_t i = 0; i < g.spheres.size(); ++i)
+        EXPECT_FLOAT_EQ(g.spheres[i].centreRadius.x, 3.0f * (i + 1));
+}
+
+TEST(GpuScene, BvhAboveTheThresholdHoldsEverySphereOnce) {
+    for (std::size_t n : {gpu::kBvhThreshold + 1, std::size_t{100}}) {
+        SCOPED_TRACE(n);
+        const snell::Scene s = parse(rowOfSpheres(n));
+        const gpu::GpuScene g = gpu::buildGpuScene(s, snell::Camera::fromSpec(10, 1));
+        ASSERT_FALSE(g.nodes.empty());
+        ASSERT_EQ(g.spheres.size(), n);
+        EXPECT_EQ(g.ellipsoids.size(), s.ellipsoidCount());
+
+        // Every scene sphere appears exactly once (identified by its x).
+        std::multiset<int> seen;
+        std::set<std::uint32_t> ellipsoidIndices;
+        for (const gpu::Sphere& sp : g.spheres) {
+            seen.insert(static_cast<int>(std::lround(sp.centreRadius.x / 3.0f)));
+            const bool isEllipsoid = sp.ellipsoid != SNELL_NOT_ELLIPSOID;
+            const int index = static_cast<int>(std::lround(sp.centreRadius.x / 3.0f)) - 1;
+            EXPECT_EQ(isEllipsoid, index % 3 == 2) << "sphere at x = " << sp.centreRadius.x;
+            if (isEllipsoid) {
+                ASSERT_LT(sp.ellipsoid, g.ellipsoids.size());
+                EXPECT_TRUE(ellipsoidIndices.insert(sp.ellipsoid).second);
+                // The ellipsoid's matrix belongs to this sphere: it maps its centre to 0.
+                const glm::vec4 c = g.ellipsoids[sp.ellipsoid].objectFromWorld *
+                                    glm::vec4(glm::vec3(sp.centreRadius), 1.0f);
+                EXPECT_NEAR(glm::length(glm::vec3(c)), 0.0f, 1e-4f);
+            }
+        }
+        for (std::size_t i = 1; i <= n; ++i) EXPECT_EQ(seen.count(static_cast<int>(i)), 1u) << i;
+
+        // The leaves reached from the root cover [0, n) exactly once, and each
+        // leaf's box contains its spheres' bounds.
+        std::vector<int> covered(n, 0);
+        std::vector<std::uint32_t> stack{0};
+        std::size_t visited = 0;
+        while (!stack.empty()) {
+            const std::uint32_t i = stack.back();
+            stack.pop_back();
+            ASSERT_LT(i, g.nodes.size());
+            ASSERT_LE(++visited, g.nodes.size());
+            const gpu::BvhNode& node = g.nodes[i];
+            if (node.count == 0) {
+                stack.push_back(node.first);
+                stack.push_back(node.first + 1);
+                continue;
+            }
+            for (std::uint32_t k = node.first; k < node.first + node.count; ++k) {
+                ASSERT_LT(k, n);
+                ++covered[k];
+                const glm::vec4 cr = g.spheres[k].centreRadius;
+                // A true sphere's radius is exact; an ellipsoid's only bounds
+                // it, so only its centre is checked.
+                const float r = g.spheres[k].ellipsoid == SNELL_NOT_ELLIPSOID ? cr.w : 0.0f;
+                for (int a = 0; a < 3; ++a) {
+                    EXPECT_LE(node.lower[a], cr[a] - r + 1e-5f);
+                    EXPECT_GE(node.upper[a], cr[a] + r - 1e-5f);
+                }
+            }
+        }
+        EXPECT_EQ(visited, g.nodes.size());
+        for (std::size_t k = 0; k < n; ++k) EXPECT_EQ(covered[k], 1) << k;
+    }
+}
+
+}  // namespace

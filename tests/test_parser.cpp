@@ -1,0 +1,531 @@
+// Scene-file parser: SPEC §1 (syntax), §2 (commands, defaults), §7 (errors).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "scene/Parser.h"
+
+namespace {
+
+using snell::dvec3;
+using snell::ParseError;
+using snell::Scene;
+namespace fs = std::filesystem;
+
+Scene parse(const std::string& text) { return snell::parseScene(text, "t.scn"); }
+
+dvec3 apply(const glm::dmat4& m, dvec3 p) { return dvec3(m * glm::dvec4(p, 1.0)); }
+
+void expectNear(dvec3 a, dvec3 b, double tolerance = 1e-12) {
+    EXPECT_NEAR(a.x, b.x, tolerance);
+    EXPECT_NEAR(a.y, b.y, tolerance);
+    EXPECT_NEAR(a.z, b.z, tolerance);
+}
+
+// Parse `text`, expect a ParseError at line:column whose message contains
+// every one of `words` (case-sensitive), and what() in SPEC §7 format.
+void expectError(const std::string& text, int line, int column, std::vector<std::string> words = {}) {
+    SCOPED_TRACE("input: " + text);
+    try {
+        parse(text);
+        ADD_FAILURE() << "expected a ParseError at " << line << ":" << column;
+    } catch (const ParseError& e) {
+        EXPECT_EQ(e.diagnostic().location.line, line) << e.what();
+        EXPECT_EQ(e.diagnostic().location.column, column) << e.what();
+        EXPECT_EQ(e.diagnostic().location.file, "t.scn");
+        const std::string prefix =
+            "t.scn:" + std::to_string(line) + ":" + std::to_string(column) + ": error: ";
+        const std::string what = e.what();
+        EXPECT_EQ(what.rfind(prefix, 0), 0u) << "what(): " << what;
+        EXPECT_GT(what.size(), prefix.size()) << "empty message";
+        for (const std::string& w : words)
+            EXPECT_NE(what.find(w), std::string::npos) << "'" << w << "' not in: " << what;
+    }
+}
+
+const std::string kView = "view 10 1\n";
+
+// ---------------------------------------------------------------- commands
+
+TEST(Parser, MinimalSceneHasSpecDefaults) {
+    const Scene s = parse("view 64 2.5\nsphere\n");
+    EXPECT_EQ(s.imageSize, 64);
+    EXPECT_DOUBLE_EQ(s.halfWidth, 2.5);
+    EXPECT_EQ(s.supersample, 1);
+    EXPECT_EQ(s.background, dvec3(0.0));
+    EXPECT_EQ(s.ambient, dvec3(0.0));
+    EXPECT_TRUE(s.lights.empty());
+    EXPECT_TRUE(s.warnings.empty());
+    EXPECT_EQ(s.name, "t");
+    ASSERT_EQ(s.spheres.size(), 1u);
+    ASSERT_EQ(s.materials.size(), 1u);
+    const snell::Material& m = s.materials[s.spheres[0].material];
+    EXPECT_EQ(m.kd, dvec3(1.0));
+    EXPECT_EQ(m.ks, dvec3(0.0));
+    EXPECT_EQ(m.phong, 1.0);
+    EXPECT_EQ(m.kt, dvec3(0.0));
+    EXPECT_EQ(m.eta, 1.0002926);
+    EXPECT_EQ(s.spheres[0].worldFromObject, glm::dmat4(1.0));
+    EXPECT_TRUE(s.spheres[0].isTrueSphere);
+    EXPECT_EQ(s.spheres[0].centre, dvec3(0.0));
+    EXPECT_EQ(s.spheres[0].radius, 1.0);
+    EXPECT_EQ(s.spheres[0].location.line, 2);
+    EXPECT_EQ(s.spheres[0].location.column, 1);
+}
+
+TEST(Parser, ViewAnywhereInFile) {
+    const Scene s = parse("sphere\nview 3 0.25\n");
+    EXPECT_EQ(s.imageSize, 3);
+    EXPECT_EQ(s.halfWidth, 0.25);
+    EXPECT_EQ(s.spheres.size(), 1u);
+}
+
+TEST(Parser, ScaleMoveRotateBuildTheTransform) {
+    const Scene s = parse(kView + "scale 2 3 4\nsphere\n" + "move 1 2 3\nsphere\n" +
+                          "rotate 90 0 0 1\nsphere\n");
+    ASSERT_EQ(s.spheres.size(), 3u);
+    // First: S(2,3,4).
+    expectNear(apply(s.spheres[0].worldFromObject, {1, 1, 1}), {2, 3, 4});
+    EXPECT_FALSE(s.spheres[0].isTrueSphere);
+    // Second: S * T(1,2,3): the origin goes to S(1,2,3) = (2,6,12).
+    expectNear(apply(s.spheres[1].worldFromObject, {0, 0, 0}), {2, 6, 12});
+    // Third: S * T * R: x axis rotates to y, then T, then S: (1,0,0) -> (0,1,0) -> (1,3,3) -> (2,9,12).
+    expectNear(apply(s.spheres[2].worldFromObject, {1, 0, 0}), {2, 9, 12});
+}
+
+TEST(Parser, LightIsNotTransformed) {
+    const Scene s = parse(kView + "move 5 6 7\nscale 2 2 2\nlight 0.1 0.2 0.3 1 2 3\nlight 4 5 6 -1 -2 -3\n");
+    ASSERT_EQ(s.lights.size(), 2u);
+    EXPECT_EQ(s.lights[0].colour, dvec3(0.1, 0.2, 0.3));
+    EXPECT_EQ(s.lights[0].position, dvec3(1, 2, 3));
+    EXPECT_EQ(s.lights[1].colour, dvec3(4, 5, 6));  // above 1 is allowed
+    EXPECT_EQ(s.lights[1].position, dvec3(-1, -2, -3));
+}
+
+TEST(Parser, BackgroundAmbientSupersampleLastOneWins) {
+    const Scene s = parse(kView + "background 0.1 0.2 0.3\nambient 1 2 3\nsupersample 4\n" +
+                          "background 0.4 0.5 0.6\nambient 0.7 0.8 0.9\nsupersample 2\n");
+    EXPECT_EQ(s.background, dvec3(0.4, 0.5, 0.6));
+    EXPECT_EQ(s.ambient, dvec3(0.7, 0.8, 0.9));
+    EXPECT_EQ(s.supersample, 2);
+}
+
+TEST(Parser, MaterialAndRefraction) {
+    const Scene s = parse(kView + "material 0.1 0.2 0.3 0.4 0.5 0.6 20\nrefraction 0.7 0.8 0.9 1.5\nsphere\n");
+    ASSERT_EQ(s.spheres.size(), 1u);
+    const snell::Material& m = s.materials[s.spheres[0].material];
+    EXPECT_EQ(m.kd, dvec3(0.1, 0.2, 0.3));
+    EXPECT_EQ(m.ks, dvec3(0.4, 0.5, 0.6));
+    EXPECT_EQ(m.phong, 20.0);
+    EXPECT_EQ(m.kt, dvec3(0.7, 0.8, 0.9));
+    EXPECT_EQ(m.eta, 1.5);
+}
+
+TEST(Parser, MaterialKeepsRefractionAndViceVersa) {
+    const Scene s = parse(kView + "refraction 1 1 1 1.33\nmaterial 0.5 0.5 0.5 0 0 0 3\nsphere\n" +
+                          "refraction 0 0 0 2\nsphere\n");
+    ASSERT_EQ(s.spheres.size(), 2u);
+    const snell::Material& a = s.materials[s.spheres[0].material];
+    const snell::Material& b = s.materials[s.spheres[1].material];
+    EXPECT_EQ(a.kd, dvec3(0.5));
+    EXPECT_EQ(a.kt, dvec3(1.0));
+    EXPECT_EQ(a.eta, 1.33);
+    EXPECT_EQ(b.kd, dvec3(0.5));  // material unchanged by refraction
+    EXPECT_EQ(b.phong, 3.0);
+    EXPECT_EQ(b.kt, dvec3(0.0));
+    EXPECT_EQ(b.eta, 2.0);
+}
+
+TEST(Parser, ZeroPhongExponentAllowed) {
+    const Scene s = parse(kView + "material 1 1 1 1 1 1 0\nsphere\n");
+    EXPECT_EQ(s.materials[s.spheres[0].material].phong, 0.0);
+}
+
+TEST(Parser, GroupRestoresTransformMaterialAndRefraction) {
+    const Scene s = parse(kView + "move 1 0 0\ngroup\nmove 0 5 0\nscale 2 2 2\n" +
+                          "material 0.1 0.1 0.1 0.2 0.2 0.2 7\nrefraction 1 1 1 1.5\nsphere\ngroupend\nsphere\n");
+    ASSERT_EQ(s.spheres.size(), 2u);
+    EXPECT_EQ(s.spheres[0].centre, dvec3(1, 5, 0));
+    EXPECT_EQ(s.spheres[0].radius, 2.0);
+    EXPECT_EQ(s.materials[s.spheres[0].material].eta, 1.5);
+    EXPECT_EQ(s.spheres[1].centre, dvec3(1, 0, 0));
+    EXPECT_EQ(s.spheres[1].radius, 1.0);
+    EXPECT_EQ(s.materials[s.spheres[1].material], snell::Material{});
+    EXPECT_TRUE(s.warnings.empty());
+}
+
+TEST(Parser, NestedGroups) {
+    const Scene s = parse(kView + "group\nmove 1 0 0\ngroup\nmove 1 0 0\nsphere\ngroupend\nsphere\n" +
+                          "groupend\nsphere\n");
+    ASSERT_EQ(s.spheres.size(), 3u);
+    EXPECT_EQ(s.spheres[0].centre, dvec3(2, 0, 0));
+    EXPECT_EQ(s.spheres[1].centre, dvec3(1, 0, 0));
+    EXPECT_EQ(s.spheres[2].centre, dvec3(0, 0, 0));
+}
+
+TEST(Parser, At256NestedGroupsSupported) {
+    std::string text = kView;
+    for (int i = 0; i < 256; ++i) text += "group\nmove 1 0 0\n";
+    text += "sphere\n";
+    for (int i = 0; i < 256; ++i) text += "groupend\n";
+    text += "sphere\n";
+    const Scene s = parse(text);
+    ASSERT_EQ(s.spheres.size(), 2u);
+    EXPECT_EQ(s.spheres[0].centre, dvec3(256, 0, 0));
+    EXPECT_EQ(s.spheres[1].centre, dvec3(0, 0, 0));
+    EXPECT_TRUE(s.warnings.empty());
+}
+
+TEST(Parser, UnclosedGroupIsAWarningNotAnError) {
+    const Scene s = parse(kView + "sphere\ngroup\nsphere\n");
+    EXPECT_EQ(s.spheres.size(), 2u);
+    ASSERT_EQ(s.warnings.size(), 1u);
+    EXPECT_EQ(s.warnings[0].location.line, 3);
+    EXPECT_EQ(s.warnings[0].location.column, 1);
+    EXPECT_NE(s.warnings[0].message.find("group"), std::string::npos);
+}
+
+TEST(Parser, NumberForms) {
+    // SPEC §1: 1, -0.5, +.5, 5., 2e-3, 2E-3.
+    const Scene s = parse(kView + "light 1 0 0.5 -0.5 +.5 5.\nlight 2e-3 2E-3 1e+2 -1E2 0 +0\n");
+    ASSERT_EQ(s.lights.size(), 2u);
+    EXPECT_EQ(s.lights[0].colour, dvec3(1, 0, 0.5));
+    EXPECT_EQ(s.lights[0].position, dvec3(-0.5, 0.5, 5.0));
+    EXPECT_EQ(s.lights[1].colour, dvec3(0.002, 0.002, 100));
+    EXPECT_EQ(s.lights[1].position, dvec3(-100, 0, 0));
+}
+
+// ---------------------------------------------------------------- syntax
+
+TEST(Parser, Comments) {
+    const Scene s = parse("# a comment first on the line\nview 10 1 # after the arguments\n"
+                          "#sphere\n   # indented comment\nmove 1 2 0.5#x\nsphere#glued\n"
+                          "material 1 1 1 0 0 0 2# glued to last\nsphere # sphere\n");
+    ASSERT_EQ(s.spheres.size(), 2u);
+    EXPECT_EQ(s.spheres[0].centre, dvec3(1, 2, 0.5));
+    EXPECT_EQ(s.materials[s.spheres[1].material].phong, 2.0);
+}
+
+TEST(Parser, CommentedOutCommandIsNotRun) {
+    // A '#' ahead of a bad command hides it entirely.
+    const Scene s = parse(kView + "#eyep 0 0 0\n#scale 0 0 0\nsphere\n");
+    EXPECT_EQ(s.spheres.size(), 1u);
+}
+
+TEST(Parser, CrLfAndNoFinalNewline) {
+    const Scene s = parse("view 10 1\r\nmove 1 0 0\r\n\r\nsphere\r\nsphere");
+    EXPECT_EQ(s.imageSize, 10);
+    ASSERT_EQ(s.spheres.size(), 2u);
+    EXPECT_EQ(s.spheres[0].centre, dvec3(1, 0, 0));
+    EXPECT_EQ(s.spheres[1].location.line, 5);
+    // Line numbers count CRLF lines once each.
+    expectError("view 10 1\r\n\r\nbogus\r\n", 3, 1, {"unknown command"});
+    // A last line without a line end that has an error is still located.
+    expectError("view 10 1\nmove 1 2 z", 2, 10);
+}
+
+TEST(Parser, TabsAndSpacesSeparateTokens) {
+    const Scene s = parse("view\t10\t1\n\tmove \t1\t 2  3\t\nsphere\t\n   \n\t\n");
+    ASSERT_EQ(s.spheres.size(), 1u);
+    EXPECT_EQ(s.spheres[0].centre, dvec3(1, 2, 3));
+    // A tab is one column (SPEC §7).
+    expectError(kView + "\tmove\t1\tx\t3\n", 2, 9, {"'x'"});
+}
+
+TEST(Parser, TrailingSpacesAllowed) {
+    const Scene s = parse("view 10 1   \nmove 1 0 0 \nsphere  \n");
+    EXPECT_EQ(s.spheres.size(), 1u);
+}
+
+TEST(Parser, ValidUtf8InCommentAccepted) {
+    const Scene s = parse(kView + "# caf\xc3\xa9 \xe2\x82\xac \xf0\x9f\x98\x80\nsphere\n");
+    EXPECT_EQ(s.spheres.size(), 1u);
+}
+
+// ---------------------------------------------------------------- errors
+
+TEST(ParserErrors, UnknownCommand) {
+    expectError(kView + "spehre\n", 2, 1, {"unknown command", "'spehre'", "sphere"});
+    expectError(kView + "  bogus 1 2\n", 2, 3, {"unknown command", "'bogus'"});
+    expectError(kView + "Sphere\n", 2, 1, {"unknown command", "sphere"});  // lower case only
+    expectError("eyep 0 0 1\nview 10 1\n", 1, 1, {"unknown command"});
+}
+
+TEST(ParserErrors, TooFewArgumentsAtCommand) {
+    expectError(kView + "scale 1 2\n", 2, 1, {"scale", "3"});
+    expectError(kView + "  move\n", 2, 3, {"move"});
+    expectError(kView + "rotate 1 2 3\n", 2, 1, {"rotate"});
+    expectError(kView + "light 1 1 1 0 0\n", 2, 1, {"light"});
+    expectError(kView + "background 1 1\n", 2, 1, {"background"});
+    expectError(kView + "ambient\n", 2, 1, {"ambient"});
+    expectError(kView + "material 1 1 1 0 0 0\n", 2, 1, {"material"});
+    expectError(kView + "refraction 1 1 1\n", 2, 1, {"refraction"});
+    expectError(kView + "supersample\n", 2, 1, {"supersample"});
+    expectError("view 10\n", 1, 1, {"view"});
+    // Too few wins over a bad value further right (the command is leftmost).
+    expectError(kView + "scale 0 1\n", 2, 1, {"scale"});
+}
+
+TEST(ParserErrors, TooManyArgumentsAtFirstExtra) {
+    expectError(kView + "move 1 2 3 4 5\n", 2, 12, {"too many"});
+    expectError(kView + "sphere 1\n", 2, 8, {"too many"});
+    expectError(kView + "group x\n", 2, 7, {"too many"});
+    expectError(kView + "groupend x\n", 2, 10, {"too many"});
+    expectError("view 10 1 1\n", 1, 11, {"too many"});
+    expectError(kView + "supersample 2  3\n", 2, 16, {"too many"});
+    expectError(kView + "light 1 1 1 0 0 0 0\n", 2, 19, {"too many"});
+    expectError(kView + "material 1 1 1 0 0 0 1 9\n", 2, 24, {"too many"});
+    expectError(kView + "refraction 1 1 1 1.5 9\n", 2, 22, {"too many"});
+}
+
+TEST(ParserErrors, NonNumeric) {
+    expectError(kView + "move 1 abc 3\n", 2, 8, {"'abc'"});
+    expectError(kView + "move 1 2 3x\n", 2, 10);
+    expectError(kView + "move . 0 0\n", 2, 6);
+    expectError(kView + "move e5 0 0\n", 2, 6);
+    expectError(kView + "move 1e 0 0\n", 2, 6);
+    expectError(kView + "move 1.2.3 0 0\n", 2, 6);
+    expectError(kView + "move --1 0 0\n", 2, 6);
+    expectError(kView + "move 1,5 0 0\n", 2, 6);
+    expectError(kView + "move 0 0 -\n", 2, 10);
+    expectError(kView + "background 0 0 one\n", 2, 16);
+}
+
+TEST(ParserErrors, NanAndInf) {
+    expectError(kView + "move nan 0 0\n", 2, 6, {"'nan'"});
+    expectError(kView + "move NaN 0 0\n", 2, 6);
+    expectError(kView + "move -nan 0 0\n", 2, 6);
+    expectError(kView + "move 0 inf 0\n", 2, 8, {"'inf'"});
+    expectError(kView + "move 0 -inf 0\n", 2, 8);
+    expectError(kView + "move 0 +Infinity 0\n", 2, 8);
+    expectError(kView + "light 1 1 1 0 0 nan\n", 2, 17);
+    expectError("view 10 inf\n", 1, 9);
+}
+
+TEST(ParserErrors, Overflow) {
+    expectError(kView + "move 1e999 0 0\n", 2, 6, {"overflow"});
+    expectError(kView + "move 0 -1e309 0\n", 2, 8, {"overflow"});
+    expectError(kView + "scale 1 1 " + std::string(400, '9') + "\n", 2, 11, {"overflow"});
+}
+
+TEST(ParserErrors, HexFloat) {
+    expectError(kView + "move 0x1p3 0 0\n", 2, 6, {"hexadecimal"});
+    expectError(kView + "move 0 -0X10 0\n", 2, 8, {"hexadecimal"});
+}
+
+TEST(ParserErrors, NegativeColoursAndCoefficients) {
+    expectError(kView + "background 0 -0.5 0\n", 2, 14);
+    expectError(kView + "ambient 0.2 0.2 -1\n", 2, 17);
+    expectError(kView + "light 1 -1 1 0 0 0\n", 2, 9);
+    expectError(kView + "material 1 1 1 0 -0.1 0 1\n", 2, 18);
+    expectError(kView + "refraction -1 0 0 1.5\n", 2, 12);
+    // Negative light positions are fine.
+    EXPECT_NO_THROW(parse(kView + "light 1 1 1 -1 -2 -3\n"));
+}
+
+TEST(ParserErrors, NegativePhongExponent) {
+    expectError(kView + "material 1 1 1 0 0 0 -1\n", 2, 22, {"Phong"});
+}
+
+TEST(ParserErrors, ZeroScaleAtTheZero) {
+    expectError(kView + "scale 1 0 1\n", 2, 9, {"zero"});
+    expectError(kView + "scale 2 2 0.0\n", 2, 11, {"zero"});
+    expectError(kView + "scale -0 2 2\n", 2, 7, {"zero"});
+    // Negative factors are allowed.
+    EXPECT_NO_THROW(parse(kView + "scale -1 2 -3\nsphere\n"));
+}
+
+TEST(ParserErrors, ZeroRotationAxisAtAxisFirstNumber) {
+    expectError(kView + "rotate 45 0 0 0\n", 2, 11, {"axis"});
+    expectError(kView + "rotate  45  0.0  -0  +0\n", 2, 13, {"axis"});
+    // Any angle is fine with a non-zero axis, however short or long.
+    EXPECT_NO_THROW(parse(kView + "rotate 720 1e-300 0 0\nrotate -30 1e300 1e300 0\nsphere\n"));
+}
+
+TEST(ParserErrors, ViewSize) {
+    expectError("view 1.5 1\n", 1, 6, {"integer"});
+    expectError("view 10. 1\n", 1, 6, {"integer"});
+    expectError("view 1e2 1\n", 1, 6, {"integer"});
+    expectError("view x 1\n", 1, 6);
+    expectError("view 0 1\n", 1, 6);
+    expectError("view -4 1\n", 1, 6);
+    expectError("view 100000000000000000000000 1\n", 1, 6);
+    expectError("view " + std::to_string(snell::ParseLimits::kMaxImageSize + 1) + " 1\n", 1, 6);
+    EXPECT_EQ(parse("view " + std::to_string(snell::ParseLimits::kMaxImageSize) + " 1\n").imageSize,
+              snell::ParseLimits::kMaxImageSize);
+    EXPECT_EQ(parse("view 1 1\n").imageSize, 1);
+}
+
+TEST(ParserErrors, ViewHalfWidth) {
+    expectError("view 10 0\n", 1, 9);
+    expectError("view 10 -0.5\n", 1, 9);
+    expectError("view 10 abc\n", 1, 9);
+}
+
+TEST(ParserErrors, MissingViewAtOneOne) {
+    expectError("", 1, 1, {"view"});
+    expectError("sphere\nmove 1 2 3\nsphere\n", 1, 1, {"view"});
+    expectError("\n\n# only comments\n", 1, 1, {"view"});
+}
+
+TEST(ParserErrors, SecondViewAtItsCommand) {
+    expectError(kView + "sphere\n  view 10 1\n", 3, 3, {"view"});
+    expectError(kView + "view 20 2\n", 2, 1, {"view"});
+}
+
+TEST(ParserErrors, SecondViewWithBadArgumentReportsTheViewFirst) {
+    // SPEC §7 file order: the second 'view' token (column 1) is itself the
+    // offending token and stands left of its bad argument.
+    expectError(kView + "view 0 1\n", 2, 1, {"view"});
+    expectError(kView + "view 10 -1\n", 2, 1, {"view"});
+}
+
+TEST(ParserErrors, GroupendWithoutGroup) {
+    expectError(kView + "groupend\n", 2, 1, {"groupend"});
+    expectError(kView + "group\ngroupend\n groupend\n", 4, 2, {"groupend"});
+}
+
+TEST(ParserErrors, GroupNestingLimit) {
+    const int limit = snell::ParseLimits::kMaxGroupDepth;
+    std::string text = kView;
+    for (int i = 0; i < limit; ++i) text += "group\n";
+    EXPECT_NO_THROW(parse(text + "sphere\n"));
+    text += "group\n";  // one too many, at line limit + 2
+    expectError(text, limit + 2, 1, {"group", std::to_string(limit)});
+}
+
+TEST(ParserErrors, SupersampleZero) {
+    expectError(kView + "supersample 0\n", 2, 13);
+    expectError(kView + "supersample -2\n", 2, 13);
+    expectError(kView + "supersample 1.5\n", 2, 13, {"integer"});
+    expectError(kView + "supersample " + std::to_string(snell::ParseLimits::kMaxSupersample + 1) + "\n",
+                2, 13);
+}
+
+TEST(ParserErrors, RefractionIndexNotPositive) {
+    expectError(kView + "refraction 0 0 0 0\n", 2, 18);
+    expectError(kView + "refraction 1 1 1 -1.5\n", 2, 18);
+    // The index may be below 1 or far above it (course files use 25).
+    EXPECT_NO_THROW(parse(kView + "refraction 1 1 1 0.5\nrefraction 1 1 1 25\n"));
+}
+
+TEST(ParserErrors, DegenerateTransformAtSphere) {
+    expectError(kView + "scale 1e-200 1e-200 1e-200\nscale 1e-200 1e-200 1e-200\nmove 0 0 0\n  sphere\n", 5, 3,
+                {"degenerate"});
+    expectError(kView + "scale 1e200 1e200 1e200\nscale 1e200 1e200 1e200\nsphere\n", 4, 1, {"degenerate"});
+    // The degenerate state alone (without a sphere) is not an error, and a
+    // group restores a good transform.
+    EXPECT_NO_THROW(parse(kView + "group\nscale 1e-200 1e-200 1e-200\nscale 1e-200 1e-200 1e-200\n"
+                                  "groupend\nsphere\n"));
+    // SPEC §5 range: tiny and huge spheres are fine.
+    EXPECT_NO_THROW(parse(kView + "scale 1e-4 1e-4 1e-4\nsphere\nscale 1e10 1e10 1e10\nsphere\n"));
+}
+
+TEST(ParserErrors, NulByte) {
+    const std::string text = kView + std::string("move 1 \0 2\n", 11);
+    expectError(text, 2, 8, {"NUL"});
+    // Even inside a comment.
+    expectError(kView + std::string("sphere # \0\n", 11), 2, 10, {"NUL"});
+}
+
+TEST(ParserErrors, InvalidUtf8) {
+    expectError(kView + "move 1 2 \xff\n", 2, 10, {"UTF-8"});
+    expectError(kView + "# comment \xc3\x28\n", 2, 11, {"UTF-8"});      // bad continuation
+    expectError(kView + "sphere #\xc0\xaf\n", 2, 9, {"UTF-8"});          // overlong
+    expectError(kView + "sphere #\xed\xa0\x80\n", 2, 9, {"UTF-8"});      // surrogate
+    expectError(kView + "sphere #\xe2\x82", 2, 9, {"UTF-8"});            // truncated at EOF
+}
+
+TEST(ParserErrors, LoneCarriageReturn) {
+    expectError("view 10 1\rsphere\n", 1, 10);
+    expectError(kView + "sphere\r\r\n", 2, 7);
+    expectError(kView + "\r", 2, 1);
+}
+
+TEST(ParserErrors, ErrorsInFileOrder) {
+    // First bad token on the line wins.
+    expectError(kView + "scale 0 x 1\n", 2, 7, {"zero"});
+    expectError(kView + "scale x 0 1\n", 2, 7, {"'x'"});
+    expectError(kView + "scale 1 1 0 extra\n", 2, 11, {"zero"});
+    expectError(kView + "rotate nan 0 0 0\n", 2, 8);
+    expectError(kView + "rotate 1 0 0 0 x\n", 2, 10, {"axis"});
+    expectError(kView + "light -1 1 1 x 0 0\n", 2, 7);
+    expectError(kView + "refraction 0 0 0 0 extra\n", 2, 18);
+    expectError(kView + "material -1 1 1 0 0 0 -1\n", 2, 10);
+    // First bad line wins.
+    expectError(kView + "move 1 2 x\nscale 0 1 1\nbogus\n", 2, 10);
+    expectError(kView + "bogus\nscale 0 1 1\n", 2, 1);
+    // A byte-level error is found where it stands, after earlier lines' errors.
+    expectError(kView + "scale 0 1 1\nsphere \xff\n", 2, 7);
+    // A bad line before the view is reported there.
+    expectError("scale 0 1 1\nview 10 1\n", 1, 7);
+}
+
+TEST(ParserErrors, ParseSceneFileMissingFile) {
+    try {
+        snell::parseSceneFile("/nonexistent-dir/none.scn");
+        ADD_FAILURE() << "expected a ParseError";
+    } catch (const ParseError& e) {
+        EXPECT_EQ(e.diagnostic().location.line, 1);
+        EXPECT_EQ(e.diagnostic().location.column, 1);
+        EXPECT_EQ(std::string(e.what()).rfind("/nonexistent-dir/none.scn:1:1: error: ", 0), 0u) << e.what();
+    }
+}
+
+// ---------------------------------------------------------------- real files
+
+TEST(ParserFiles, CourseScenesParseWithReadmeSphereCounts) {
+    const std::map<std::string, std::size_t> expected = {
+        {"becker-1n.scn", 6},          {"becker-refract.scn", 10},     {"becker-SphereFlake1.scn", 11},
+        {"becker-SphereFlake2.scn", 92}, {"becker-SphereFlake3.scn", 821}, {"becker-SphereFlake4.scn", 7382},
+        {"gonzalez-1n.scn", 6},        {"gonzalez-originalTest.scn", 3},
+    };
+    std::map<std::string, std::size_t> found;
+    for (const auto& entry : fs::directory_iterator(SNELL_SOURCE_DIR "/../shared/course-scenes")) {
+        if (entry.path().extension() != ".scn") continue;
+        const std::string name = entry.path().filename().string();
+        SCOPED_TRACE(name);
+        try {
+            const Scene s = snell::parseSceneFile(entry.path().string());
+            found[name] = s.spheres.size();
+            EXPECT_GT(s.imageSize, 0);
+            EXPECT_GT(s.halfWidth, 0.0);
+        } catch (const ParseError& e) {
+            ADD_FAILURE() << e.what();
+        }
+    }
+    EXPECT_EQ(found, expected);
+}
+
+TEST(ParserFiles, CourseSceneQuirks) {
+    const std::string dir = SNELL_SOURCE_DIR "/../shared/course-scenes/";
+    const Scene gonzalez = snell::parseSceneFile(dir + "gonzalez-1n.scn");
+    EXPECT_FALSE(gonzalez.warnings.empty());  // last group never closed
+    EXPECT_NE(gonzalez.ambient, dvec3(0.0));
+    const Scene flake = snell::parseSceneFile(dir + "becker-SphereFlake1.scn");
+    EXPECT_EQ(flake.supersample, 8);
+    const Scene refract = snell::parseSceneFile(dir + "becker-refract.scn");
+    EXPECT_EQ(refract.imageSize, 2000);
+    EXPECT_GT(refract.ellipsoidCount(), 0u);
+}
+
+TEST(ParserFiles, ProjectScenesParse) {
+    const fs::path dir = SNELL_SOURCE_DIR "/scenes";
+    if (!fs::exists(dir)) return;
+    for (const auto& entry : fs::recursive_directory_iterator(dir)) {
+        if (!entry.is_regular_file() || entry.path().extension() != ".scn") continue;
+        SCOPED_TRACE(entry.path().string());
+        try {
+            const Scene s = snell::parseSceneFile(entry.path().string());
+            EXPECT_GT(s.imageSize, 0);
+        } catch (const ParseError& e) {
+            ADD_FAILURE() << e.what();
+        }
+    }
+}
+
+}  // namespace
