@@ -147,7 +147,7 @@ TEST(Parser, ZeroPhongExponentAllowed) {
 
 TEST(Parser, GroupRestoresTransformMaterialAndRefraction) {
     const Scene s = parse(kView + "move 1 0 0\ngroup\nmove 0 5 0\nscale 2 2 2\n" +
-                          "material 0.1 0.1 0.1 0.2 0.2 0.2 7\nrefraction 1 1 1 1.5\nsphere\ngroupend\nsphere\n");
+                          "material 0.1 0.1 0.1 0.2 0.2 0.2 7\nrefraction 0.5 0.5 0.5 1.5\nsphere\ngroupend\nsphere\n");
     ASSERT_EQ(s.spheres.size(), 2u);
     EXPECT_EQ(s.spheres[0].centre, dvec3(1, 5, 0));
     EXPECT_EQ(s.spheres[0].radius, 2.0);
@@ -274,7 +274,7 @@ TEST(ParserErrors, TooManyArgumentsAtFirstExtra) {
     expectError(kView + "move 1 2 3 4 5\n", 2, 12, {"too many"});
     expectError(kView + "sphere 1\n", 2, 8, {"too many"});
     expectError(kView + "group x\n", 2, 7, {"too many"});
-    expectError(kView + "groupend x\n", 2, 10, {"too many"});
+    expectError(kView + "group\ngroupend x\n", 3, 10, {"too many"});
     expectError("view 10 1 1\n", 1, 11, {"too many"});
     expectError(kView + "supersample 2  3\n", 2, 16, {"too many"});
     expectError(kView + "light 1 1 1 0 0 0 0\n", 2, 19, {"too many"});

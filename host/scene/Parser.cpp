@@ -121,7 +121,8 @@ public:
             std::size_t end = pos;
             while (end < text_.size() && text_[end] != '\n') ++end;
             std::string_view line = text_.substr(pos, end - pos);
-            if (!line.empty() && line.back() == '\r') line.remove_suffix(1);  // CRLF
+            // CRLF; a CR not followed by LF (even at the end of the file) is an error.
+            if (end < text_.size() && !line.empty() && line.back() == '\r') line.remove_suffix(1);
             parseLine(line, lineNumber);
             pos = end + 1;
             ++lineNumber;
@@ -201,9 +202,22 @@ private:
             fail(name, "'" + std::string(spec.name) + "' expects " + std::to_string(spec.arity) +
                            " argument" + (spec.arity == 1 ? "" : "s") + " (" +
                            std::string(spec.usage) + "), got " + std::to_string(given));
-        // Arguments are checked left to right, extra ones after (SPEC §7 file order).
-        args_.clear();
+        // Errors that belong to the command token come first, then the
+        // arguments left to right, then extra arguments (SPEC §7 file order).
         const std::string_view n = spec.name;
+        if (n == "view" && viewLocation_)
+            fail(name, "second 'view' command (the first is at line " + std::to_string(viewLocation_->line) +
+                           "); a scene has exactly one");
+        if (n == "groupend" && groupStack_.empty()) fail(name, "'groupend' without a matching 'group'");
+        if (n == "group" && groupStack_.size() >= static_cast<std::size_t>(ParseLimits::kMaxGroupDepth))
+            fail(name, "groups nested deeper than snell's limit of " +
+                           std::to_string(ParseLimits::kMaxGroupDepth) + " levels");
+        if (n == "sphere" && scene_.spheres.size() >= ParseLimits::kMaxSpheres)
+            fail(name, "too many spheres: snell's limit is " + std::to_string(ParseLimits::kMaxSpheres));
+        if (n == "sphere" && !state_.transform.invertible())
+            fail(name, "the current transform is degenerate (not invertible in double precision)");
+        if (n == "light" && scene_.lights.size() >= ParseLimits::kMaxLights)
+            fail(name, "too many lights: snell's limit is " + std::to_string(ParseLimits::kMaxLights));
         if (n == "view") view();
         else if (n == "sphere") sphere();
         else if (n == "scale") scale();
