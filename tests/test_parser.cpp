@@ -443,7 +443,10 @@ TEST(ParserErrors, InvalidUtf8) {
 TEST(ParserErrors, LoneCarriageReturn) {
     expectError("view 10 1\rsphere\n", 1, 10);
     expectError(kView + "sphere\r\r\n", 2, 7);
+    expectError(kView + "\r\r\nsphere\n", 2, 1);
+    // The last line has no line end, so its final CR is a lone one too.
     expectError(kView + "\r", 2, 1);
+    expectError(kView + "sphere\r", 2, 7);
 }
 
 TEST(ParserErrors, ErrorsInFileOrder) {

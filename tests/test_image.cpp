@@ -1,0 +1,299 @@
+// Image files (PNG, PPM, PFM), SPEC §6 byte conversion, atomic writes, and the
+// error metrics.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <sstream>
+#include <string>
+
+#include <unistd.h>
+
+#include "image/ImageIO.h"
+#include "metrics/ImageMetrics.h"
+
+namespace {
+
+namespace fs = std::filesystem;
+using snell::Image;
+using snell::ImageIOError;
+
+// A fresh, empty directory per test, removed afterwards.
+class ImageFiles : public ::testing::Test {
+protected:
+    void SetUp() override {
+        const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+        dir_ = fs::temp_directory_path() /
+               ("snell-test-image-" + std::to_string(::getpid()) + "-" + info->name());
+        fs::remove_all(dir_);
+        fs::create_directories(dir_);
+    }
+    void TearDown() override { fs::remove_all(dir_); }
+    std::string path(const std::string& name) const { return (dir_ / name).string(); }
+    std::size_t entries() const {
+        return static_cast<std::size_t>(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()));
+    }
+    static std::string slurp(const std::string& p) {
+        std::ifstream in(p, std::ios::binary);
+        std::ostringstream s;
+        s << in.rdbuf();
+        return s.str();
+    }
+    fs::path dir_;
+};
+
+// 3 x 2, every channel a distinct byte value (5, 19, ..., 243), so
+// orientation errors show.
+Image byteImage() {
+    Image image(3, 2);
+    for (std::size_t i = 0; i < image.rgb.size(); ++i) image.rgb[i] = static_cast<float>(i * 14 + 5) / 255.0f;
+    return image;
+}
+
+TEST_F(ImageFiles, PpmRoundTrip) {
+    const Image image = byteImage();
+    snell::writeImage(path("a.ppm"), image);
+    const Image back = snell::readImage(path("a.ppm"));
+    ASSERT_EQ(back.width, 3);
+    ASSERT_EQ(back.height, 2);
+    ASSERT_EQ(back.rgb.size(), image.rgb.size());
+    for (std::size_t i = 0; i < image.rgb.size(); ++i) EXPECT_EQ(back.rgb[i], image.rgb[i]) << i;
+    // P6 header, then the bytes, rows top to bottom.
+    const std::string data = slurp(path("a.ppm"));
+    const std::string header = "P6\n3 2\n255\n";
+    ASSERT_EQ(data.rfind(header, 0), 0u);
+    ASSERT_EQ(data.size(), header.size() + 18);
+    for (std::size_t i = 0; i < 18; ++i)
+        EXPECT_EQ(static_cast<unsigned char>(data[header.size() + i]), i * 14 + 5) << i;
+    EXPECT_EQ(entries(), 1u);  // no temporary left behind
+}
+
+TEST_F(ImageFiles, PngRoundTrip) {
+    const Image image = byteImage();
+    snell::writeImage(path("a.png"), image);
+    const Image back = snell::readImage(path("a.png"));
+    ASSERT_EQ(back.width, 3);
+    ASSERT_EQ(back.height, 2);
+    ASSERT_EQ(back.rgb.size(), image.rgb.size());
+    for (std::size_t i = 0; i < image.rgb.size(); ++i) EXPECT_EQ(back.rgb[i], image.rgb[i]) << i;
+    EXPECT_EQ(slurp(path("a.png")).substr(1, 3), "PNG");
+    EXPECT_EQ(entries(), 1u);
+}
+
+TEST_F(ImageFiles, EightBitFormatsClamp) {
+    Image image(2, 2);
+    const float values[12] = {1.5f, -0.3f, 0.0f, 1.0f, 100.0f, std::numeric_limits<float>::quiet_NaN(),
+                              std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity(),
+                              0.5f, 2.0f, 0.25f, 1e-9f};
+    std::copy(values, values + 12, image.rgb.begin());
+    // 0.25 * 255 = 63.75 -> 64; 0.5 * 255 = 127.5 -> 128 (halves up).
+    const float expected[12] = {1, 0, 0, 1, 1, 0, 1, 0, 128 / 255.0f, 1, 64 / 255.0f, 0};
+    for (const char* name : {"c.ppm", "c.png"}) {
+        SCOPED_TRACE(name);
+        snell::writeImage(path(name), image);
+        const Image back = snell::readImage(path(name));
+        ASSERT_EQ(back.rgb.size(), 12u);
+        for (int i = 0; i < 12; ++i) EXPECT_EQ(back.rgb[i], expected[i]) << i;
+    }
+}
+
+TEST_F(ImageFiles, PfmRoundTripIsExactAndUnclamped) {
+    Image image(3, 2);
+    const float values[18] = {3.5f, -2.25f, 1e-7f, 1e30f, 0.0f, -0.0f, 1.0f / 3.0f, 255.75f, -1e-20f,
+                              0.5f, 7.0f, 1.0f, 2.0f, 3.0f, 4.0f, 5.0f, 6.0f, -7.0f};
+    std::copy(values, values + 18, image.rgb.begin());
+    snell::writeImage(path("f.pfm"), image);
+    const Image back = snell::readImage(path("f.pfm"));
+    ASSERT_EQ(back.width, 3);
+    ASSERT_EQ(back.height, 2);
+    ASSERT_EQ(back.rgb.size(), 18u);
+    for (int i = 0; i < 18; ++i) {
+        EXPECT_EQ(back.rgb[i], values[i]) << i;
+        EXPECT_EQ(std::signbit(back.rgb[i]), std::signbit(values[i])) << i;
+    }
+    // Little-endian PFM, rows stored bottom to top: the first float stored is
+    // the first pixel of the bottom row (row 1), i.e. value 9.
+    const std::string data = slurp(path("f.pfm"));
+    const std::string header = "PF\n3 2\n-1.0\n";
+    ASSERT_EQ(data.rfind(header, 0), 0u);
+    ASSERT_EQ(data.size(), header.size() + 18 * sizeof(float));
+    float first;
+    std::memcpy(&first, data.data() + header.size(), sizeof first);
+    EXPECT_EQ(first, values[9]);
+}
+
+TEST(ToByte, RoundingAndClamping) {
+    EXPECT_EQ(snell::toByte(0.0f), 0);
+    EXPECT_EQ(snell::toByte(1.0f), 255);
+    EXPECT_EQ(snell::toByte(-1.0f), 0);
+    EXPECT_EQ(snell::toByte(-0.0f), 0);
+    EXPECT_EQ(snell::toByte(2.0f), 255);
+    EXPECT_EQ(snell::toByte(std::numeric_limits<float>::infinity()), 255);
+    EXPECT_EQ(snell::toByte(-std::numeric_limits<float>::infinity()), 0);
+    EXPECT_EQ(snell::toByte(std::numeric_limits<float>::quiet_NaN()), 0);
+    // 255 * 0.5 = 127.5 exactly: halves round up.
+    EXPECT_EQ(snell::toByte(0.5f), 128);
+    // Every k/255 maps back to k.
+    for (int k = 0; k <= 255; ++k) EXPECT_EQ(snell::toByte(k / 255.0f), k) << k;
+}
+
+TEST(ToByte, HalfStepBoundaries) {
+    // The floats on either side of (k + 0.5)/255 round down and up.
+    // (127.5/255 = 0.5 is an exact half: see RoundingAndClamping.)
+    for (int k : {0, 1, 100, 200, 254}) {
+        SCOPED_TRACE(k);
+        const double half = (k + 0.5) / 255.0;
+        float below = static_cast<float>(half);
+        if (static_cast<double>(below) * 255.0 >= k + 0.5) below = std::nextafter(below, 0.0f);
+        const float above = std::nextafter(below, 1.0f);
+        ASSERT_LT(static_cast<double>(below) * 255.0, k + 0.5);
+        ASSERT_GT(static_cast<double>(above) * 255.0, k + 0.5);
+        EXPECT_EQ(snell::toByte(below), k);
+        EXPECT_EQ(snell::toByte(above), k + 1);
+    }
+}
+
+TEST_F(ImageFiles, WriteIntoMissingDirectoryThrowsAndLeavesNothing) {
+    const std::string target = path("missing/sub/x.png");
+    EXPECT_THROW(snell::writeImage(target, byteImage()), ImageIOError);
+    EXPECT_FALSE(fs::exists(target));
+    EXPECT_FALSE(fs::exists(path("missing")));
+    EXPECT_EQ(entries(), 0u);
+    EXPECT_THROW(snell::checkWritable(target), ImageIOError);
+    EXPECT_NO_THROW(snell::checkWritable(path("fine.png")));
+}
+
+TEST_F(ImageFiles, ExistingFileReplacedOnlyOnSuccess) {
+    const std::string target = path("out.ppm");
+    { std::ofstream(target) << "precious"; }
+    snell::writeImage(target, byteImage());
+    EXPECT_EQ(slurp(target).rfind("P6\n", 0), 0u);
+    EXPECT_EQ(entries(), 1u);
+
+    // A failing write (unknown format) leaves an existing file untouched.
+    const std::string jpg = path("out.jpg");
+    { std::ofstream(jpg) << "precious"; }
+    EXPECT_THROW(snell::writeImage(jpg, byteImage()), ImageIOError);
+    EXPECT_EQ(slurp(jpg), "precious");
+
+    // A failing rename (the target is a non-empty directory) leaves it, and
+    // no temporary file.
+    const std::string asDir = path("dir.png");
+    fs::create_directories(fs::path(asDir) / "keep");
+    EXPECT_THROW(snell::writeImage(asDir, byteImage()), ImageIOError);
+    EXPECT_TRUE(fs::is_directory(fs::path(asDir) / "keep"));
+    EXPECT_EQ(entries(), 3u);  // out.ppm, out.jpg, dir.png
+    EXPECT_THROW(snell::checkWritable(asDir), ImageIOError);
+}
+
+TEST(ImageFormat, ByExtension) {
+    EXPECT_EQ(snell::formatForPath("a.png"), snell::ImageFormat::Png);
+    EXPECT_EQ(snell::formatForPath("dir.x/a.ppm"), snell::ImageFormat::Ppm);
+    EXPECT_EQ(snell::formatForPath("a.pfm"), snell::ImageFormat::Pfm);
+    EXPECT_EQ(snell::formatForPath("A.PNG"), snell::ImageFormat::Png);
+    EXPECT_THROW(snell::formatForPath("a.jpg"), ImageIOError);
+    EXPECT_THROW(snell::formatForPath("a.png.jpg"), ImageIOError);
+    EXPECT_THROW(snell::formatForPath("noextension"), ImageIOError);
+    EXPECT_THROW(snell::formatForPath("png"), ImageIOError);
+    try {
+        snell::formatForPath("x.jpg");
+    } catch (const ImageIOError& e) {
+        EXPECT_NE(std::string(e.what()).find(".png"), std::string::npos) << e.what();
+    }
+}
+
+TEST_F(ImageFiles, ReadErrors) {
+    EXPECT_THROW(snell::readImage(path("none.ppm")), ImageIOError);
+    { std::ofstream(path("short.ppm"), std::ios::binary) << "P6\n4 4\n255\nabc"; }
+    EXPECT_THROW(snell::readImage(path("short.ppm")), ImageIOError);
+    { std::ofstream(path("bad.pfm"), std::ios::binary) << "P3\n1 1\n255\n0 0 0\n"; }
+    EXPECT_THROW(snell::readImage(path("bad.pfm")), ImageIOError);
+    { std::ofstream(path("bad.png"), std::ios::binary) << "not a png at all"; }
+    EXPECT_THROW(snell::readImage(path("bad.png")), ImageIOError);
+}
+
+// ---------------------------------------------------------------- metrics
+
+// Channels given as 8-bit values (non-finite values kept as they are).
+Image fromBytes(int w, int h, std::initializer_list<float> bytes) {
+    Image image(w, h);
+    std::size_t i = 0;
+    for (float b : bytes) image.rgb[i++] = std::isfinite(b) ? b / 255.0f : b;
+    return image;
+}
+
+TEST(Metrics, HandMadePair) {
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    const Image reference = fromBytes(2, 2, {100, 100, 100, 100, 100, 100, 100, 100, 100, 100, 100, 100});
+    // Differences per channel: pixel 0 none, pixel 1 r +2, pixel 2 g -10,
+    // pixel 3 b NaN (-> byte 0: 100).
+    const Image test = fromBytes(2, 2, {100, 100, 100, 102, 100, 100, 100, 90, 100, 100, 100, nan});
+    const snell::ImageMetrics m = snell::compareImages(test, reference);
+    EXPECT_EQ(m.pixels, 4u);
+    EXPECT_NEAR(m.meanAbsError, 112.0 / 12.0, 1e-12);
+    EXPECT_NEAR(m.rmse, std::sqrt((4.0 + 100.0 + 10000.0) / 12.0), 1e-12);
+    EXPECT_NEAR(m.psnr, 20.0 * std::log10(255.0 / m.rmse), 1e-9);
+    EXPECT_EQ(m.maxError, 100);
+    EXPECT_EQ(m.badPixels, 2u);  // threshold 3: pixels 2 and 3
+    EXPECT_DOUBLE_EQ(m.badFraction, 0.5);
+    EXPECT_EQ(m.nonFinite, 1u);
+    EXPECT_NE(m.json().find("\"non_finite\": 1"), std::string::npos) << m.json();
+    EXPECT_NE(m.json().find("\"max_error\": 100"), std::string::npos) << m.json();
+
+    // A difference equal to the threshold is not bad.
+    EXPECT_EQ(snell::compareImages(test, reference, 10).badPixels, 1u);
+    EXPECT_EQ(snell::compareImages(test, reference, 1).badPixels, 3u);
+    EXPECT_EQ(snell::compareImages(test, reference, 2).badPixels, 2u);
+}
+
+TEST(Metrics, IdenticalAndClampedImages) {
+    const Image a = fromBytes(1, 2, {1, 2, 3, 4, 5, 6});
+    const snell::ImageMetrics same = snell::compareImages(a, a);
+    EXPECT_EQ(same.meanAbsError, 0.0);
+    EXPECT_EQ(same.maxError, 0);
+    EXPECT_EQ(same.badPixels, 0u);
+    EXPECT_TRUE(std::isinf(same.psnr));
+    EXPECT_NE(same.json().find("\"psnr\": null"), std::string::npos) << same.json();
+    // Values above 1 compare after clamping: 1.0 and 7.0 are the same 8-bit colour.
+    Image b(1, 1), c(1, 1);
+    b.rgb = {1.0f, 0.0f, 0.5f};
+    c.rgb = {7.0f, -3.0f, 0.5f};
+    const snell::ImageMetrics clamped = snell::compareImages(c, b);
+    EXPECT_EQ(clamped.maxError, 0);
+    EXPECT_EQ(clamped.nonFinite, 0u);
+}
+
+TEST(Metrics, SizeMismatchThrows) {
+    EXPECT_THROW(snell::compareImages(Image(2, 3), Image(3, 2)), std::invalid_argument);
+}
+
+TEST(Metrics, DifferenceImage) {
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    const Image reference = fromBytes(3, 1, {100, 100, 100, 100, 100, 100, 100, 100, 100});
+    const Image test = fromBytes(3, 1, {100, 100, 100, 200, 100, 100, nan, 100, 100});
+    const Image d = snell::differenceImage(test, reference);
+    ASSERT_EQ(d.width, 3);
+    ASSERT_EQ(d.height, 1);
+    ASSERT_EQ(d.rgb.size(), 9u);
+    // Equal: black. Far off (100 >= 16): full red. NaN: magenta.
+    EXPECT_EQ(d.pixel(0, 0)[0], 0.0f);
+    EXPECT_EQ(d.pixel(0, 0)[1], 0.0f);
+    EXPECT_EQ(d.pixel(0, 0)[2], 0.0f);
+    EXPECT_EQ(d.pixel(1, 0)[0], 1.0f);
+    EXPECT_EQ(d.pixel(1, 0)[2], 0.0f);
+    EXPECT_EQ(d.pixel(2, 0)[0], 1.0f);
+    EXPECT_EQ(d.pixel(2, 0)[1], 0.0f);
+    EXPECT_EQ(d.pixel(2, 0)[2], 1.0f);
+    // A small difference is bluer than a large one.
+    const Image small = fromBytes(3, 1, {101, 100, 100, 100, 100, 100, 100, 100, 100});
+    const Image ds = snell::differenceImage(small, reference);
+    EXPECT_GT(ds.pixel(0, 0)[2], ds.pixel(0, 0)[0]);
+    EXPECT_GT(ds.pixel(0, 0)[0], 0.0f);
+    // Same size as a non-square input.
+    EXPECT_EQ(snell::differenceImage(Image(4, 7), Image(4, 7)).rgb.size(), 4u * 7u * 3u);
+}
+
+}  // namespace
