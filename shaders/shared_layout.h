@@ -31,6 +31,10 @@ using uint = std::uint32_t;
 #define SNELL_BINDING_LIGHTS 5
 #define SNELL_BINDING_BVH 6
 #define SNELL_BINDING_COUNTERS 7
+#define SNELL_BINDING_PIXEL_STATES 8
+#define SNELL_BINDING_RAY_STACK 9
+#define SNELL_BINDING_MEDIA_STACK 10
+#define SNELL_BINDING_COUNT 11
 
 // Specialization constants: compile only what a scene uses.
 #define SNELL_SPEC_USE_BVH 0
@@ -42,19 +46,30 @@ using uint = std::uint32_t;
 #define SNELL_SPEC_MAX_MEDIA 6
 #define SNELL_SPEC_RAY_STACK 7
 #define SNELL_SPEC_AMPLIFYING 8
+#define SNELL_SPEC_LOOP_BUDGET 9
+#define SNELL_SPEC_COUNT 10
 
 // Sphere::ellipsoid when the sphere is a true sphere (centre + radius).
 #define SNELL_NOT_ELLIPSOID 0xffffffffu
-// Ray-counter slots in the counters buffer.
+// Slots of the counters buffer: rays by kind, then per-dispatch bookkeeping.
 #define SNELL_COUNTER_PRIMARY 0
 #define SNELL_COUNTER_SHADOW 1
 #define SNELL_COUNTER_REFLECTED 2
 #define SNELL_COUNTER_REFRACTED 3
-#define SNELL_COUNTER_COUNT 4
+#define SNELL_RAY_COUNTER_COUNT 4
+#define SNELL_COUNTER_UNFINISHED 4  // pixels still tracing after this dispatch
+#define SNELL_COUNTER_LOOP_LIMIT 5  // subgroups that may have hit the driver's loop limit
+#define SNELL_COUNTER_COUNT 6
 
-// Hard upper bounds of the shader's fixed-size arrays.
+// Mesa's llvmpipe (lavapipe) ends every loop of a shader once one SIMD row has
+// run 65535 loop iterations in total in a dispatch. On such a driver a pixel
+// suspends its ray tree (state below) when its subgroup has spent
+// SNELL_LOOP_BUDGET iterations, and the next dispatch resumes it.
+#define SNELL_DRIVER_LOOP_LIMIT 65535u
+#define SNELL_LOOP_BUDGET_LLVMPIPE 32768u
+
+// Hard upper bound of the shader's per-ray medium stack.
 #define SNELL_MAX_MEDIA_LIMIT 16
-#define SNELL_BVH_STACK 48
 
 // One primitive. Coordinates are camera-relative (world minus eye), prepared
 // in double on the host. For a true sphere centreRadius is (centre, radius);
@@ -86,15 +101,38 @@ struct Light {
     vec4 colour;    // rgb, w unused
 };
 
-// BVH node (host/bvh/Bvh.h): an inner node has count == 0 and its children at
-// first and first + 1; a leaf holds spheres [first, first + count).
+// BVH node, stored in depth-first order so the shader walks it without a
+// stack: an inner node's first child is the next node; `skip` is the node
+// after this one's subtree (where to go on a miss, or after a leaf). A leaf
+// (count > 0) holds spheres [first, first + count).
 struct BvhNode {
     vec4 lower;
     vec4 upper;
     uint first;
     uint count;
+    uint skip;
     uint pad0;
-    uint pad1;
+};
+
+// A pixel's progress between dispatches (one per pixel of the tile).
+struct PixelState {
+    vec4 sum;       // rgb: sum of the finished samples and of the current one so far
+    uint started;   // samples started
+    uint pending;   // rays waiting on this pixel's stack
+    uint done;
+    uint pad0;
+};
+
+// A ray waiting to be traced (SPEC §4 ray tree, depth first). Its medium stack
+// is kept beside it in the media buffer.
+struct PendingRay {
+    vec4 origin;     // xyz
+    vec4 direction;  // xyz, unit
+    vec4 weight;     // rgb: product of the ks/kt factors along its path
+    uint depth;
+    uint fromSphere; // the sphere whose surface it starts on
+    uint inward;     // 1 if it heads into that sphere
+    uint mediaCount;
 };
 
 // Per-render parameters (uniform buffer). The primary ray through the image

@@ -5,6 +5,9 @@
 // the intersection maths is explained in host/reference/Intersect.h.
 #version 460
 #extension GL_GOOGLE_include_directive : require
+#extension GL_KHR_shader_subgroup_basic : require
+#extension GL_KHR_shader_subgroup_vote : require
+#extension GL_KHR_shader_subgroup_arithmetic : require
 #include "shared_layout.h"
 
 layout(local_size_x = SNELL_WORKGROUP_SIZE_X, local_size_y = SNELL_WORKGROUP_SIZE_Y) in;
@@ -20,6 +23,9 @@ layout(constant_id = SNELL_SPEC_COUNT_RAYS) const bool COUNT_RAYS = false;
 layout(constant_id = SNELL_SPEC_MAX_MEDIA) const int MAX_MEDIA = 1;
 layout(constant_id = SNELL_SPEC_RAY_STACK) const int RAY_STACK = 8;
 layout(constant_id = SNELL_SPEC_AMPLIFYING) const bool AMPLIFYING = false;
+// Loop iterations a subgroup may spend in one dispatch before its pixels
+// suspend; 0: no limit (drivers without llvmpipe's loop limiter).
+layout(constant_id = SNELL_SPEC_LOOP_BUDGET) const uint LOOP_BUDGET = 0u;
 
 layout(set = 0, binding = SNELL_BINDING_OUTPUT_IMAGE, rgba32f) uniform writeonly image2D outputImage;
 layout(set = 0, binding = SNELL_BINDING_FRAME, std140) uniform FrameBlock { FrameParams frame; };
@@ -28,7 +34,10 @@ layout(set = 0, binding = SNELL_BINDING_ELLIPSOIDS, std430) readonly buffer Elli
 layout(set = 0, binding = SNELL_BINDING_MATERIALS, std430) readonly buffer MaterialBlock { Material materials[]; };
 layout(set = 0, binding = SNELL_BINDING_LIGHTS, std430) readonly buffer LightBlock { Light lights[]; };
 layout(set = 0, binding = SNELL_BINDING_BVH, std430) readonly buffer BvhBlock { BvhNode nodes[]; };
-layout(set = 0, binding = SNELL_BINDING_COUNTERS, std430) buffer CounterBlock { uint rayCounters[]; };
+layout(set = 0, binding = SNELL_BINDING_COUNTERS, std430) buffer CounterBlock { uint counters[]; };
+layout(set = 0, binding = SNELL_BINDING_PIXEL_STATES, std430) buffer PixelStateBlock { PixelState pixelStates[]; };
+layout(set = 0, binding = SNELL_BINDING_RAY_STACK, std430) buffer RayStackBlock { PendingRay rayStack[]; };
+layout(set = 0, binding = SNELL_BINDING_MEDIA_STACK, std430) buffer MediaStackBlock { uint mediaStack[]; };
 layout(push_constant) uniform TileBlock { TileParams tile; };
 
 const uint NONE = 0xffffffffu;
@@ -38,7 +47,16 @@ const uint ELSEWHERE = 0u;
 const uint LEAVING = 1u;
 const uint ENTERING = 2u;
 
-uint countedRays[SNELL_COUNTER_COUNT];
+uint countedRays[SNELL_RAY_COUNTER_COUNT];
+
+// Loop iterations this subgroup has run in this dispatch, as llvmpipe's loop
+// limiter counts them: every pass of a loop with some lane active, plus one
+// final pass per loop entry. One lane of the active ones counts each pass, so
+// the subgroup's sum is the count. Compiled out when LOOP_BUDGET is 0.
+uint loopTicks = 0u;
+void tick() {
+    if (LOOP_BUDGET != 0u && subgroupElect()) loopTicks++;
+}
 
 // ---------------------------------------------------------------------------
 // Intersection: Haines et al. (Ray Tracing Gems ch. 7) roots; exact chord root
@@ -100,106 +118,94 @@ bool hitsBox(uint node, vec3 origin, vec3 inverseDir, float tMax) {
     return enter <= leave;
 }
 
-// The BVH traversal stack, one per invocation (module scope: see occluded()).
-uint bvhStack[SNELL_BVH_STACK];
-
 vec3 safeInverse(vec3 d) {
     const float tiny = 1e-30;
     return 1.0 / mix(d, vec3(tiny) * sign(d + vec3(1e-38)), lessThan(abs(d), vec3(tiny)));
 }
 
 // SPEC §4.1: the closest hit with t > 0; returns the sphere index or NONE.
+// The BVH is walked without a stack (nodes in depth-first order with skip
+// links, see shared_layout.h): no per-invocation array, which matters on
+// lavapipe, where dynamically indexed private arrays go to scratch memory.
 uint closestHit(vec3 origin, vec3 dir, uint fromSphere, uint start, out float tHit) {
     tHit = NO_HIT;
     uint hit = NONE;
     if (!USE_BVH) {
+        tick();
         for (uint i = 0u; i < frame.sphereCount; ++i) {
+            tick();
             float t = intersectSphere(i, origin, dir, fromSphere, start);
             if (t < tHit) { tHit = t; hit = i; }
         }
         return hit;
     }
     vec3 inverseDir = safeInverse(dir);
-    int top = 0;
-    bvhStack[top++] = 0u;
-    while (top > 0) {
-        uint node = bvhStack[--top];
-        if (!hitsBox(node, origin, inverseDir, tHit)) continue;
-        uint first = nodes[node].first;
-        uint count = nodes[node].count;
-        if (count > 0u) {
-            for (uint i = first; i < first + count; ++i) {
-                float t = intersectSphere(i, origin, dir, fromSphere, start);
-                if (t < tHit) { tHit = t; hit = i; }
-            }
-        } else if (top + 2 <= SNELL_BVH_STACK) {
-            bvhStack[top++] = first + 1u;
-            bvhStack[top++] = first;
+    uint node = 0u;
+    tick();
+    while (node < frame.bvhNodeCount) {
+        tick();
+        if (!hitsBox(node, origin, inverseDir, tHit)) {
+            node = nodes[node].skip;
+            continue;
         }
+        uint count = nodes[node].count;
+        if (count == 0u) {
+            node++;
+            continue;
+        }
+        uint first = nodes[node].first;
+        tick();
+        for (uint i = first; i < first + count; ++i) {
+            tick();
+            float t = intersectSphere(i, origin, dir, fromSphere, start);
+            if (t < tHit) { tHit = t; hit = i; }
+        }
+        node = nodes[node].skip;
     }
     return hit;
 }
 
 // SPEC §4.3 visibility: does any surface cross the open segment (0, distance)?
-// (Loops end through their conditions, not early returns: lavapipe has
-// miscompiled a return from inside this traversal for whole SIMD rows.)
 bool occluded(vec3 origin, vec3 dir, float distance, uint fromSphere, uint start) {
     bool blocked = false;
     if (!USE_BVH) {
-        for (uint i = 0u; i < frame.sphereCount && !blocked; ++i)
+        tick();
+        for (uint i = 0u; i < frame.sphereCount && !blocked; ++i) {
+            tick();
             blocked = intersectSphere(i, origin, dir, fromSphere, start) < distance;
+        }
         return blocked;
     }
     vec3 inverseDir = safeInverse(dir);
-    int top = 0;
-    bvhStack[top++] = 0u;
-    while (top > 0 && !blocked) {
-        uint node = bvhStack[--top];
-        if (!hitsBox(node, origin, inverseDir, distance)) continue;
-        uint first = nodes[node].first;
-        uint count = nodes[node].count;
-        if (count > 0u) {
-            for (uint i = first; i < first + count && !blocked; ++i)
-                blocked = intersectSphere(i, origin, dir, fromSphere, start) < distance;
-        } else if (top + 2 <= SNELL_BVH_STACK) {
-            bvhStack[top++] = first + 1u;
-            bvhStack[top++] = first;
+    uint node = 0u;
+    tick();
+    while (node < frame.bvhNodeCount && !blocked) {
+        tick();
+        if (!hitsBox(node, origin, inverseDir, distance)) {
+            node = nodes[node].skip;
+            continue;
         }
+        uint count = nodes[node].count;
+        if (count == 0u) {
+            node++;
+            continue;
+        }
+        uint first = nodes[node].first;
+        tick();
+        for (uint i = first; i < first + count && !blocked; ++i) {
+            tick();
+            blocked = intersectSphere(i, origin, dir, fromSphere, start) < distance;
+        }
+        node = nodes[node].skip;
     }
     return blocked;
 }
 
 // ---------------------------------------------------------------------------
-// The ray tree (SPEC §4), depth first on an explicit stack. Each pending ray
-// carries its weight, depth, the sphere it starts on and its medium stack.
-
-vec3 pendingOrigin[RAY_STACK];
-vec3 pendingDir[RAY_STACK];
-vec3 pendingWeight[RAY_STACK];
-uint pendingInfo[RAY_STACK];     // depth | inward << 16
-uint pendingFrom[RAY_STACK];
-uint pendingMediaCount[RAY_STACK];
-uint pendingMedia[RAY_STACK * MAX_MEDIA];
-int pendingTop = 0;
-
-uint currentMedia[MAX_MEDIA];
-uint currentMediaCount = 0u;
-
-float mediumEta(uint count, uint innermost) {
-    return count == 0u ? frame.background.w : materials[spheres[innermost].material].kt.w;
-}
-
-void push(vec3 origin, vec3 dir, vec3 weight, uint depth, uint fromSphere, bool inward) {
-    if (pendingTop >= RAY_STACK) return;  // cannot happen: RAY_STACK = maxDepth + 1
-    int slot = pendingTop++;
-    pendingOrigin[slot] = origin;
-    pendingDir[slot] = dir;
-    pendingWeight[slot] = weight;
-    pendingInfo[slot] = depth | (inward ? 0x10000u : 0u);
-    pendingFrom[slot] = fromSphere;
-    pendingMediaCount[slot] = currentMediaCount;
-    for (uint k = 0u; k < currentMediaCount; ++k) pendingMedia[slot * MAX_MEDIA + int(k)] = currentMedia[k];
-}
+// The ray tree (SPEC §4), depth first on an explicit stack kept per pixel in
+// rayStack/mediaStack, so a pixel can suspend between dispatches. Each pending
+// ray carries its weight, depth, the sphere it starts on, whether it heads into
+// that sphere, and its medium stack (innermost last).
 
 bool worthTracing(vec3 w) {
     float m = max(w.x, max(w.y, w.z));
@@ -209,144 +215,231 @@ bool worthTracing(vec3 w) {
 // Local Phong term with binary shadows (SPEC §4.3) at x with shading normal n.
 vec3 shade(Material m, vec3 x, vec3 n, vec3 v, uint hitSphere, bool fromOutside) {
     vec3 local = frame.ambient.rgb * m.kd.rgb;
-    if (!HAS_LIGHTS) return local;
-    uint start = fromOutside ? LEAVING : ENTERING;
-    for (uint j = 0u; j < frame.lightCount; ++j) {
-        vec3 l = lights[j].position.xyz - x;
-        float distance = length(l);
-        l /= distance;
-        float nl = dot(n, l);
-        if (!(nl > 0.0)) continue;
-        if (COUNT_RAYS) countedRays[SNELL_COUNTER_SHADOW]++;
-        if (occluded(x, l, distance, hitSphere, start)) continue;
-        float rv = dot(2.0 * nl * n - l, v);
-        float specular = rv > 0.0 ? pow(rv, m.kd.w) : 0.0;
-        local += lights[j].colour.rgb * (m.kd.rgb * nl + m.ks.rgb * specular);
+    if (HAS_LIGHTS) {
+        // A shadow ray towards N's side enters the hit sphere only when N = −No.
+        uint start = fromOutside ? LEAVING : ENTERING;
+        tick();
+        for (uint j = 0u; j < frame.lightCount; ++j) {
+            tick();
+            vec3 l = lights[j].position.xyz - x;
+            float distance = length(l);
+            l /= distance;
+            float nl = dot(n, l);
+            if (nl > 0.0) {
+                if (COUNT_RAYS) countedRays[SNELL_COUNTER_SHADOW]++;
+                if (!occluded(x, l, distance, hitSphere, start)) {
+                    float rv = dot(2.0 * nl * n - l, v);
+                    float specular = rv > 0.0 ? pow(rv, m.kd.w) : 0.0;
+                    local += lights[j].colour.rgb * (m.kd.rgb * nl + m.ks.rgb * specular);
+                }
+            }
+        }
     }
     return local;
 }
 
-void trace(vec3 origin, vec3 dir, inout vec3 pixelSum, float saturation) {
-    pendingTop = 0;
-    currentMediaCount = 0u;
-    push(origin, dir, vec3(1.0), 0u, NONE, false);
-    if (COUNT_RAYS) countedRays[SNELL_COUNTER_PRIMARY]++;
-    while (pendingTop > 0) {
-        int slot = --pendingTop;
-        vec3 o = pendingOrigin[slot];
-        vec3 d = pendingDir[slot];
-        vec3 weight = pendingWeight[slot];
-        uint depth = pendingInfo[slot] & 0xffffu;
-        bool inward = (pendingInfo[slot] & 0x10000u) != 0u;
-        uint fromSphere = pendingFrom[slot];
-        if (AMPLIFYING) weight = mix(weight, vec3(0.0), greaterThanEqual(pixelSum, vec3(saturation)));
-        if (!worthTracing(weight)) continue;
+// The medium a ray is in: the innermost sphere of its stack, or air.
+float mediumEta(uint mediaBase, uint count) {
+    return count == 0u ? frame.background.w
+                       : materials[spheres[mediaStack[mediaBase + count - 1u]].material].kt.w;
+}
 
-        // 1. Closest hit.
-        float t;
-        uint hitSphere = closestHit(o, d, fromSphere, inward ? ENTERING : LEAVING, t);
-        if (hitSphere == NONE) {
-            pixelSum += weight * frame.background.rgb;
-            continue;
-        }
-        Sphere s = spheres[hitSphere];
-        Material m = materials[s.material];
+void pushRay(uint pixel, inout PixelState state, vec3 origin, vec3 dir, vec3 weight, uint depth,
+             uint fromSphere, bool inward, uint mediaCount) {
+    uint slot = pixel * uint(RAY_STACK) + state.pending;
+    rayStack[slot] = PendingRay(vec4(origin, 0.0), vec4(dir, 0.0), vec4(weight, 0.0), depth, fromSphere,
+                                inward ? 1u : 0u, mediaCount);
+    state.pending++;
+}
 
-        // 2. Hit point re-projected onto the surface; outward and shading normals.
-        vec3 x, outward;
-        if (HAS_ELLIPSOIDS && s.ellipsoid != SNELL_NOT_ELLIPSOID) {
-            // No re-projection: normalising p would spread the rounding of its
-            // largest component (huge for a flat ellipsoid seen edge-on) into
-            // the others. o + t d is as exact as float allows.
-            mat4 objectFromWorld = ellipsoids[s.ellipsoid].objectFromWorld;
-            vec3 p = (objectFromWorld * vec4(o, 1.0)).xyz + t * (mat3(objectFromWorld) * d);
-            x = o + t * d;
-            outward = normalize(transpose(mat3(objectFromWorld)) * p);
+// Trace the ray on top of the pixel's stack: closest hit, local term, and its
+// children pushed (reflection first, so refraction is traced next).
+void traceOneRay(uint pixel, inout PixelState state, float saturation) {
+    state.pending--;
+    uint slot = pixel * uint(RAY_STACK) + state.pending;
+    PendingRay r = rayStack[slot];
+    vec3 o = r.origin.xyz;
+    vec3 d = r.direction.xyz;
+    vec3 weight = r.weight.rgb;
+    if (AMPLIFYING) weight = mix(weight, vec3(0.0), greaterThanEqual(state.sum.rgb, vec3(saturation)));
+    if (!worthTracing(weight)) return;
+
+    // 1. Closest hit.
+    float t;
+    uint hitSphere = closestHit(o, d, r.fromSphere, r.inward != 0u ? ENTERING : LEAVING, t);
+    if (hitSphere == NONE) {
+        state.sum.rgb += weight * frame.background.rgb;
+        return;
+    }
+    Sphere s = spheres[hitSphere];
+    Material m = materials[s.material];
+
+    // 2. Hit point; outward normal No and shading normal N.
+    vec3 x, outward;
+    if (HAS_ELLIPSOIDS && s.ellipsoid != SNELL_NOT_ELLIPSOID) {
+        // No re-projection: normalising p would spread the rounding of its
+        // largest component (huge for a flat ellipsoid seen edge-on) into the
+        // others. o + t d is as exact as float allows.
+        mat4 objectFromWorld = ellipsoids[s.ellipsoid].objectFromWorld;
+        vec3 p = (objectFromWorld * vec4(o, 1.0)).xyz + t * (mat3(objectFromWorld) * d);
+        x = o + t * d;
+        outward = normalize(transpose(mat3(objectFromWorld)) * p);
+    } else {
+        // Re-projected onto the sphere.
+        outward = normalize(o - s.centreRadius.xyz + t * d);
+        x = s.centreRadius.xyz + s.centreRadius.w * outward;
+    }
+    bool fromOutside = dot(d, outward) < 0.0;
+    vec3 n = fromOutside ? outward : -outward;
+
+    // 3. Local term.
+    state.sum.rgb += weight * shade(m, x, n, -d, hitSphere, fromOutside);
+    if (r.depth >= frame.maxDepth) return;
+
+    // 4. Reflection and 5. refraction. The popped slot's media stay in place
+    // for the reflected child; a refracted child's media go in its own slot.
+    vec3 reflectedWeight = HAS_REFLECTION ? weight * m.ks.rgb : vec3(0.0);
+    uint parentMedia = slot * uint(MAX_MEDIA);
+    if (HAS_REFRACTION && max(m.kt.r, max(m.kt.g, m.kt.b)) > 0.0) {
+        vec3 transmittedWeight = weight * m.kt.rgb;
+        uint count = r.mediaCount;
+        float etaI, etaT;
+        // The refracted child takes the slot above the reflected one.
+        uint childMedia = parentMedia + uint(MAX_MEDIA);
+        uint childCount = 0u;
+        if (fromOutside) {
+            // Entering: this sphere becomes the innermost medium.
+            etaI = mediumEta(parentMedia, count);
+            etaT = m.kt.w;
+            uint first = count == uint(MAX_MEDIA) ? 1u : 0u;  // full: forget the outermost
+            tick();
+            for (uint k = first; k < count; ++k) {
+                tick();
+                mediaStack[childMedia + childCount] = mediaStack[parentMedia + k];
+                childCount++;
+            }
+            mediaStack[childMedia + childCount] = hitSphere;
+            childCount++;
         } else {
-            outward = normalize(o - s.centreRadius.xyz + t * d);
-            x = s.centreRadius.xyz + s.centreRadius.w * outward;
-        }
-        bool fromOutside = dot(d, outward) < 0.0;
-        vec3 n = fromOutside ? outward : -outward;
-
-        // 3. Local term.
-        pixelSum += weight * shade(m, x, n, -d, hitSphere, fromOutside);
-        if (depth >= frame.maxDepth) continue;
-
-        // 4–5. Children. The medium stack of this ray becomes current.
-        uint mediaCount = pendingMediaCount[slot];
-        for (uint k = 0u; k < mediaCount; ++k) currentMedia[k] = pendingMedia[slot * MAX_MEDIA + int(k)];
-        currentMediaCount = mediaCount;
-        vec3 reflectedWeight = HAS_REFLECTION ? weight * m.ks.rgb : vec3(0.0);
-        vec3 reflected = d - 2.0 * dot(d, n) * n;
-        if (HAS_REFRACTION && max(m.kt.r, max(m.kt.g, m.kt.b)) > 0.0) {
-            vec3 transmittedWeight = weight * m.kt.rgb;
-            float etaI, etaT;
-            if (fromOutside) {
-                etaI = mediumEta(currentMediaCount, currentMediaCount > 0u ? currentMedia[currentMediaCount - 1u] : 0u);
-                etaT = m.kt.w;
-                if (currentMediaCount == uint(MAX_MEDIA)) {  // deeper than the scene can nest: drop outermost
-                    for (int k = 0; k + 1 < MAX_MEDIA; ++k) currentMedia[k] = currentMedia[k + 1];
-                    currentMediaCount--;
-                }
-                currentMedia[currentMediaCount++] = hitSphere;
-            } else {
-                etaI = m.kt.w;
-                for (int k = int(currentMediaCount) - 1; k >= 0; --k) {
-                    if (currentMedia[k] == hitSphere) {
-                        for (int j = k; j + 1 < int(currentMediaCount); ++j) currentMedia[j] = currentMedia[j + 1];
-                        currentMediaCount--;
-                        break;
-                    }
-                }
-                etaT = mediumEta(currentMediaCount, currentMediaCount > 0u ? currentMedia[currentMediaCount - 1u] : 0u);
+            // Leaving: remove this sphere wherever it is (innermost occurrence).
+            etaI = m.kt.w;
+            uint innermost = count;
+            tick();
+            for (uint k = 0u; k < count; ++k) {
+                tick();
+                if (mediaStack[parentMedia + k] == hitSphere) innermost = k;
             }
-            // Snell's law, SPEC §4.5.
-            float eta = etaI / etaT;
-            float c = -dot(n, d);
-            float k = 1.0 - eta * eta * (1.0 - c * c);
-            if (k < 0.0) {
-                // Total internal reflection: the reflected ray, same medium.
-                reflectedWeight += transmittedWeight;
-            } else if (worthTracing(transmittedWeight)) {
-                if (COUNT_RAYS) countedRays[SNELL_COUNTER_REFRACTED]++;
-                push(x, normalize(eta * d + (eta * c - sqrt(k)) * n), transmittedWeight, depth + 1u,
-                     hitSphere, fromOutside);
+            tick();
+            for (uint k = 0u; k < count; ++k) {
+                tick();
+                if (k != innermost) {
+                    mediaStack[childMedia + childCount] = mediaStack[parentMedia + k];
+                    childCount++;
+                }
             }
-            // Reflected rays keep the parent's medium stack.
-            for (uint j = 0u; j < mediaCount; ++j) currentMedia[j] = pendingMedia[slot * MAX_MEDIA + int(j)];
-            currentMediaCount = mediaCount;
+            etaT = mediumEta(childMedia, childCount);
         }
-        if (HAS_REFLECTION || HAS_REFRACTION) {
-            if (worthTracing(reflectedWeight)) {
+        // Snell's law, SPEC §4.5.
+        float eta = etaI / etaT;
+        float c = -dot(n, d);
+        float k = 1.0 - eta * eta * (1.0 - c * c);
+        if (k < 0.0) {
+            // Total internal reflection is the reflected ray in the same medium:
+            // one ray carries both weights.
+            reflectedWeight += transmittedWeight;
+        } else if (worthTracing(transmittedWeight)) {
+            if (COUNT_RAYS) countedRays[SNELL_COUNTER_REFRACTED]++;
+            if (HAS_REFLECTION && worthTracing(reflectedWeight)) {
+                // The reflected child reuses the parent's slot and media; the
+                // refracted one goes above it, its media already in place.
                 if (COUNT_RAYS) countedRays[SNELL_COUNTER_REFLECTED]++;
-                push(x, reflected, reflectedWeight, depth + 1u, hitSphere, !fromOutside);
+                pushRay(pixel, state, x, d - 2.0 * dot(d, n) * n, reflectedWeight, r.depth + 1u, hitSphere,
+                        !fromOutside, r.mediaCount);
+                pushRay(pixel, state, x, normalize(eta * d + (eta * c - sqrt(k)) * n), transmittedWeight,
+                        r.depth + 1u, hitSphere, fromOutside, childCount);
+                return;
             }
+            pushRay(pixel, state, x, normalize(eta * d + (eta * c - sqrt(k)) * n), transmittedWeight,
+                    r.depth + 1u, hitSphere, fromOutside, childCount);
+            // Its media were built one slot up: move them into its slot.
+            uint top = pixel * uint(RAY_STACK) + state.pending - 1u;
+            if (top != slot + 1u) {
+                tick();
+                for (uint j = 0u; j < childCount; ++j) {
+                    tick();
+                    mediaStack[top * uint(MAX_MEDIA) + j] = mediaStack[childMedia + j];
+                }
+            }
+            return;
         }
+    }
+    if ((HAS_REFLECTION || HAS_REFRACTION) && worthTracing(reflectedWeight)) {
+        // Reflected rays keep the parent's medium stack, already in this slot.
+        if (COUNT_RAYS) countedRays[SNELL_COUNTER_REFLECTED]++;
+        pushRay(pixel, state, x, d - 2.0 * dot(d, n) * n, reflectedWeight, r.depth + 1u, hitSphere,
+                !fromOutside, r.mediaCount);
     }
 }
 
 void main() {
     uvec2 local = gl_GlobalInvocationID.xy;
-    if (local.x >= tile.width || local.y >= tile.height) return;
-    uvec2 pixel = local + uvec2(tile.originX, tile.originY);
-    for (int k = 0; k < SNELL_COUNTER_COUNT; ++k) countedRays[k] = 0u;
+    bool inTile = local.x < tile.width && local.y < tile.height;
+    uint pixel = local.y * tile.width + local.x;
+    for (int k = 0; k < SNELL_RAY_COUNTER_COUNT; ++k) countedRays[k] = 0u;
 
+    PixelState state;
+    bool done = true;
+    if (inTile) {
+        state = pixelStates[pixel];
+        done = state.done != 0u;
+    }
     // SPEC §3: s×s rays through (i + (a+½)/s, j + (b+½)/s); mean, then clamp on output.
     uint s = frame.supersample;
-    float samples = float(s * s);
-    float saturation = AMPLIFYING ? samples : NO_HIT;
-    vec3 sum = vec3(0.0);
-    for (uint k = 0u; k < s * s; ++k) {
-        uint a = k % s;
-        uint b = k / s;
-        vec2 p = vec2(pixel) + (vec2(a, b) + 0.5) / float(s);
-        vec3 dir = normalize(frame.cornerDir.xyz + p.x * frame.pixelRight.xyz + p.y * frame.pixelDown.xyz);
-        trace(vec3(0.0), dir, sum, saturation);
+    uint samples = s * s;
+    float saturation = AMPLIFYING ? float(samples) : NO_HIT;
+    uvec2 imagePixel = local + uvec2(tile.originX, tile.originY);
+
+    // Every lane stays in this loop until the subgroup leaves it together, so
+    // the subgroup operations below see all lanes.
+    while (true) {
+        if (LOOP_BUDGET != 0u) {
+            if (subgroupAll(done) || subgroupAdd(loopTicks) >= LOOP_BUDGET) break;
+        } else if (done) {
+            break;
+        }
+        tick();
+        if (!done) {
+            if (state.pending == 0u) {
+                if (state.started == samples) {
+                    done = true;
+                } else {
+                    // Camera: the next primary ray of this pixel.
+                    uvec2 ab = uvec2(state.started % s, state.started / s);
+                    vec2 p = vec2(imagePixel) + (vec2(ab) + 0.5) / float(s);
+                    vec3 dir = normalize(frame.cornerDir.xyz + p.x * frame.pixelRight.xyz + p.y * frame.pixelDown.xyz);
+                    uint slot = pixel * uint(RAY_STACK);
+                    rayStack[slot] = PendingRay(vec4(0.0), vec4(dir, 0.0), vec4(1.0), 0u, NONE, 0u, 0u);
+                    state.pending = 1u;
+                    state.started++;
+                    if (COUNT_RAYS) countedRays[SNELL_COUNTER_PRIMARY]++;
+                }
+            } else {
+                traceOneRay(pixel, state, saturation);
+            }
+        }
     }
-    imageStore(outputImage, ivec2(local), vec4(sum / samples, 1.0));
+
+    if (inTile) {
+        state.done = done ? 1u : 0u;
+        pixelStates[pixel] = state;
+        if (done) imageStore(outputImage, ivec2(local), vec4(state.sum.rgb / float(samples), 1.0));
+        else atomicAdd(counters[SNELL_COUNTER_UNFINISHED], 1u);
+    }
     if (COUNT_RAYS) {
-        for (int k = 0; k < SNELL_COUNTER_COUNT; ++k)
-            if (countedRays[k] != 0u) atomicAdd(rayCounters[k], countedRays[k]);
+        for (int k = 0; k < SNELL_RAY_COUNTER_COUNT; ++k)
+            if (countedRays[k] != 0u) atomicAdd(counters[k], countedRays[k]);
     }
+    // Past the driver's limit some loop may have been cut short: say so.
+    if (LOOP_BUDGET != 0u && subgroupElect() && subgroupAdd(loopTicks) >= SNELL_DRIVER_LOOP_LIMIT)
+        atomicAdd(counters[SNELL_COUNTER_LOOP_LIMIT], 1u);
 }

@@ -48,8 +48,8 @@ TEST(Layout, BvhNode) {
     EXPECT_EQ(offsetof(gpu::BvhNode, upper), 16u);
     EXPECT_EQ(offsetof(gpu::BvhNode, first), 32u);
     EXPECT_EQ(offsetof(gpu::BvhNode, count), 36u);
-    EXPECT_EQ(offsetof(gpu::BvhNode, pad0), 40u);
-    EXPECT_EQ(offsetof(gpu::BvhNode, pad1), 44u);
+    EXPECT_EQ(offsetof(gpu::BvhNode, skip), 40u);
+    EXPECT_EQ(offsetof(gpu::BvhNode, pad0), 44u);
 }
 
 TEST(Layout, FrameParams) {
@@ -213,22 +213,22 @@ TEST(GpuScene, BvhAboveTheThresholdHoldsEverySphereOnce) {
         }
         for (std::size_t i = 1; i <= n; ++i) EXPECT_EQ(seen.count(static_cast<int>(i)), 1u) << i;
 
-        // The leaves reached from the root cover [0, n) exactly once, and each
-        // leaf's box contains its spheres' bounds.
+        // Walked as the shader walks it (depth-first order, every box entered:
+        // next node for an inner node, skip after a leaf), the leaves cover
+        // [0, n) exactly once, each node is visited once, skips only go forward
+        // and each leaf's box contains its spheres' bounds.
         std::vector<int> covered(n, 0);
-        std::vector<std::uint32_t> stack{0};
         std::size_t visited = 0;
-        while (!stack.empty()) {
-            const std::uint32_t i = stack.back();
-            stack.pop_back();
-            ASSERT_LT(i, g.nodes.size());
+        for (std::uint32_t i = 0; i < g.nodes.size();) {
             ASSERT_LE(++visited, g.nodes.size());
             const gpu::BvhNode& node = g.nodes[i];
+            ASSERT_GT(node.skip, i);
+            ASSERT_LE(node.skip, g.nodes.size());
             if (node.count == 0) {
-                stack.push_back(node.first);
-                stack.push_back(node.first + 1);
+                ++i;
                 continue;
             }
+            i = node.skip;
             for (std::uint32_t k = node.first; k < node.first + node.count; ++k) {
                 ASSERT_LT(k, n);
                 ++covered[k];

@@ -135,6 +135,7 @@ int runRender(const RenderOptions& o) {
     snell::Image image;
     snell::RayCounts rays;
     double uploadMs = 0, pipelineMs = 0, renderMs = 0, readbackMs = 0;
+    int tiles = 0, dispatches = 0;
     std::string device, timing;
     std::size_t trueSpheres = scene.spheres.size() - scene.ellipsoidCount();
     if (o.cpu) {
@@ -164,6 +165,8 @@ int runRender(const RenderOptions& o) {
             renderMs = r.renderMs;
             pipelineMs = r.pipelineMs;
             readbackMs = r.readbackMs;
+            tiles = r.tiles;
+            dispatches = r.dispatches;
             timing = r.gpuTimed ? "gpu-timestamps" : "host";
             if (o.validation && context.validationMessages() > 0) {
                 std::cerr << "snell: error: the Vulkan validation layer reported " << context.validationMessages()
@@ -203,6 +206,7 @@ int runRender(const RenderOptions& o) {
           << ", \"lights\": " << scene.lights.size() << ", \"parse_ms\": " << parseMs
           << ", \"upload_ms\": " << uploadMs << ", \"pipeline_ms\": " << pipelineMs
           << ", \"render_ms\": " << renderMs << ", \"render_timing\": \"" << timing << "\""
+          << ", \"tiles\": " << tiles << ", \"dispatches\": " << dispatches
           << ", \"readback_ms\": " << readbackMs << ", \"write_ms\": " << writeMs
           << ", \"total_ms\": " << msSince(totalStart) << ", \"rays\": {\"primary\": " << rays.primary
           << ", \"shadow\": " << rays.shadow << ", \"reflected\": " << rays.reflected

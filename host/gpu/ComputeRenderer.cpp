@@ -20,8 +20,6 @@ double msSince(Clock::time_point start) {
 }
 
 constexpr VkBufferUsageFlags kStorage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
-// Primary rays per submission: keeps each submission short on any device.
-constexpr std::uint64_t kRaysPerTile = 1u << 18;
 
 }  // namespace
 
@@ -36,7 +34,9 @@ struct ComputeRenderer::Pipeline {
     VkCommandPool commandPool = VK_NULL_HANDLE;
     VkCommandBuffer commands = VK_NULL_HANDLE;
     VkFence fence = VK_NULL_HANDLE;
-    vk::Buffer frame, counters, readback;
+    vk::Buffer frame, counters, readback, pixelStates, rayStack, mediaStack;
+    std::uint32_t rayStackDepth = 1;  // the RAY_STACK specialisation
+    std::uint32_t maxMedia = 1;       // the MAX_MEDIA specialisation
     vk::StorageImage image;
 };
 
@@ -72,7 +72,7 @@ ComputeRenderer::~ComputeRenderer() {
 
 void ComputeRenderer::createPipeline(const RenderRequest& request, bool countRays, Pipeline& p) {
     VkDevice device = context_.device();
-    std::array<VkDescriptorSetLayoutBinding, 8> bindings{};
+    std::array<VkDescriptorSetLayoutBinding, SNELL_BINDING_COUNT> bindings{};
     for (std::uint32_t i = 0; i < bindings.size(); ++i) {
         bindings[i].binding = i;
         bindings[i].descriptorCount = 1;
@@ -101,7 +101,7 @@ void ComputeRenderer::createPipeline(const RenderRequest& request, bool countRay
 
     // Specialise to the scene: only what it uses is compiled.
     const bool hasRefraction = layout_.refractiveSpheres > 0;
-    std::array<std::uint32_t, 9> values{};
+    std::array<std::uint32_t, SNELL_SPEC_COUNT> values{};
     values[SNELL_SPEC_USE_BVH] = !layout_.nodes.empty();
     values[SNELL_SPEC_HAS_ELLIPSOIDS] = !layout_.ellipsoids.empty();
     values[SNELL_SPEC_HAS_REFRACTION] = hasRefraction;
@@ -114,7 +114,10 @@ void ComputeRenderer::createPipeline(const RenderRequest& request, bool countRay
     values[SNELL_SPEC_RAY_STACK] = static_cast<std::uint32_t>(
         (hasRefraction || scene_.anyReflection()) ? request.trace.maxDepth + 1 : 1);
     values[SNELL_SPEC_AMPLIFYING] = layout_.amplifying;
-    std::array<VkSpecializationMapEntry, 9> entries{};
+    values[SNELL_SPEC_LOOP_BUDGET] = context_.isLlvmpipe() ? SNELL_LOOP_BUDGET_LLVMPIPE : 0u;
+    p.rayStackDepth = values[SNELL_SPEC_RAY_STACK];
+    p.maxMedia = values[SNELL_SPEC_MAX_MEDIA];
+    std::array<VkSpecializationMapEntry, SNELL_SPEC_COUNT> entries{};
     for (std::uint32_t i = 0; i < entries.size(); ++i)
         entries[i] = {i, i * static_cast<std::uint32_t>(sizeof(std::uint32_t)), sizeof(std::uint32_t)};
     VkSpecializationInfo spec{static_cast<std::uint32_t>(entries.size()), entries.data(),
@@ -131,7 +134,7 @@ void ComputeRenderer::createPipeline(const RenderRequest& request, bool countRay
 
     std::array<VkDescriptorPoolSize, 3> sizes{{{VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1},
                                                {VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1},
-                                               {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 6}}};
+                                               {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, SNELL_BINDING_COUNT - 2}}};
     VkDescriptorPoolCreateInfo poolInfo{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
     poolInfo.maxSets = 1;
     poolInfo.poolSizeCount = static_cast<std::uint32_t>(sizes.size());
@@ -176,8 +179,39 @@ void ComputeRenderer::destroyPipeline(Pipeline& p) {
     context_.destroy(p.frame);
     context_.destroy(p.counters);
     context_.destroy(p.readback);
+    context_.destroy(p.pixelStates);
+    context_.destroy(p.rayStack);
+    context_.destroy(p.mediaStack);
     context_.destroy(p.image);
 }
+
+namespace {
+
+void imageBarrier(VkCommandBuffer cmd, VkImage image, VkImageLayout from, VkImageLayout to, VkAccessFlags srcAccess,
+                  VkAccessFlags dstAccess, VkPipelineStageFlags srcStage, VkPipelineStageFlags dstStage) {
+    VkImageMemoryBarrier b{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
+    b.srcAccessMask = srcAccess;
+    b.dstAccessMask = dstAccess;
+    b.oldLayout = from;
+    b.newLayout = to;
+    b.srcQueueFamilyIndex = b.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
+    b.image = image;
+    b.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+    vkCmdPipelineBarrier(cmd, srcStage, dstStage, 0, 0, nullptr, 0, nullptr, 1, &b);
+}
+
+void memoryBarrier(VkCommandBuffer cmd, VkAccessFlags srcAccess, VkAccessFlags dstAccess, VkPipelineStageFlags srcStage,
+                   VkPipelineStageFlags dstStage) {
+    VkMemoryBarrier b{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
+    b.srcAccessMask = srcAccess;
+    b.dstAccessMask = dstAccess;
+    vkCmdPipelineBarrier(cmd, srcStage, dstStage, 0, 1, &b, 0, nullptr, 0, nullptr);
+}
+
+// Device memory for the pixels' suspended ray trees, per tile.
+constexpr VkDeviceSize kTileStateBudget = 64ull << 20;
+
+}  // namespace
 
 GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool countRays) {
     if (request.camera.eye != layout_.eye)
@@ -185,33 +219,52 @@ GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool count
     GpuRenderResult result;
     result.image = Image(request.width, request.height);
     Pipeline p;
+    VkDevice device = context_.device();
     try {
         const auto pipelineStart = Clock::now();
         createPipeline(request, countRays, p);
         result.pipelineMs = msSince(pipelineStart);
 
-        // Tiles: square, a multiple of the workgroup, sized by rays per submission.
+        // Tiles: square, a multiple of the workgroup, as large as the memory for
+        // the pixels' ray stacks allows (at most 1024²).
         const int s = std::max(1, request.supersample);
-        const auto side = static_cast<int>(std::sqrt(double(kRaysPerTile) / (double(s) * s)));
-        const int tileSide = std::clamp(side / 8 * 8, 8, 1024);
+        const VkDeviceSize bytesPerPixel = sizeof(gpu::PixelState) +
+                                           VkDeviceSize(p.rayStackDepth) * (sizeof(gpu::PendingRay) + p.maxMedia * 4);
+        const VkDeviceSize limit = context_.properties().limits.maxStorageBufferRange;
+        const VkDeviceSize maxPixels = std::min(kTileStateBudget, limit) / bytesPerPixel;
+        const int tileSide = std::clamp(static_cast<int>(std::sqrt(double(maxPixels))) / 8 * 8, 8, 1024);
         const int tileW = std::min(tileSide, request.width);
         const int tileH = std::min(tileSide, request.height);
+        const VkDeviceSize tilePixels = VkDeviceSize(tileW) * tileH;
 
         const gpu::FrameParams frame = gpu::makeFrameParams(scene_, layout_, request.camera, request.width,
                                                             request.height, s, request.trace.maxDepth,
                                                             request.trace.minWeight);
         p.frame = context_.createBufferWithData(&frame, sizeof frame, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
-        p.counters = context_.createBuffer(SNELL_COUNTER_COUNT * sizeof(std::uint32_t),
-                                           kStorage | VK_BUFFER_USAGE_TRANSFER_DST_BIT, true);
+        p.counters = context_.createBuffer(SNELL_COUNTER_COUNT * sizeof(std::uint32_t), kStorage, true);
+        p.pixelStates = context_.createBuffer(tilePixels * sizeof(gpu::PixelState),
+                                              kStorage | VK_BUFFER_USAGE_TRANSFER_DST_BIT, false);
+        p.rayStack = context_.createBuffer(tilePixels * p.rayStackDepth * sizeof(gpu::PendingRay), kStorage, false);
+        p.mediaStack = context_.createBuffer(tilePixels * p.rayStackDepth * p.maxMedia * 4, kStorage, false);
         p.image = context_.createStorageImage(tileW, tileH, VK_FORMAT_R32G32B32A32_SFLOAT);
         p.readback = context_.createBuffer(VkDeviceSize(tileW) * tileH * 4 * sizeof(float),
                                            VK_BUFFER_USAGE_TRANSFER_DST_BIT, true);
 
         VkDescriptorImageInfo imageInfo{VK_NULL_HANDLE, p.image.view, VK_IMAGE_LAYOUT_GENERAL};
-        std::array<VkDescriptorBufferInfo, 8> bufferInfo{};
-        const vk::Buffer* buffers[8] = {nullptr, &p.frame, &spheres_, &ellipsoids_, &materials_, &lights_, &nodes_, &p.counters};
-        std::array<VkWriteDescriptorSet, 8> writes{};
-        for (std::uint32_t i = 0; i < 8; ++i) {
+        std::array<VkDescriptorBufferInfo, SNELL_BINDING_COUNT> bufferInfo{};
+        std::array<const vk::Buffer*, SNELL_BINDING_COUNT> buffers{};
+        buffers[SNELL_BINDING_FRAME] = &p.frame;
+        buffers[SNELL_BINDING_SPHERES] = &spheres_;
+        buffers[SNELL_BINDING_ELLIPSOIDS] = &ellipsoids_;
+        buffers[SNELL_BINDING_MATERIALS] = &materials_;
+        buffers[SNELL_BINDING_LIGHTS] = &lights_;
+        buffers[SNELL_BINDING_BVH] = &nodes_;
+        buffers[SNELL_BINDING_COUNTERS] = &p.counters;
+        buffers[SNELL_BINDING_PIXEL_STATES] = &p.pixelStates;
+        buffers[SNELL_BINDING_RAY_STACK] = &p.rayStack;
+        buffers[SNELL_BINDING_MEDIA_STACK] = &p.mediaStack;
+        std::array<VkWriteDescriptorSet, SNELL_BINDING_COUNT> writes{};
+        for (std::uint32_t i = 0; i < SNELL_BINDING_COUNT; ++i) {
             writes[i] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
             writes[i].dstSet = p.set;
             writes[i].dstBinding = i;
@@ -226,80 +279,115 @@ GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool count
                 writes[i].pBufferInfo = &bufferInfo[i];
             }
         }
-        vkUpdateDescriptorSets(context_.device(), static_cast<std::uint32_t>(writes.size()), writes.data(), 0, nullptr);
+        vkUpdateDescriptorSets(device, SNELL_BINDING_COUNT, writes.data(), 0, nullptr);
+
+        // Record, submit and wait for one command buffer.
+        double hostRenderMs = 0.0, gpuRenderMs = 0.0;
+        auto submit = [&](auto record, bool timed) {
+            VkCommandBuffer cmd = p.commands;
+            check(vkResetCommandBuffer(cmd, 0), "vkResetCommandBuffer");
+            VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+            begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+            check(vkBeginCommandBuffer(cmd, &begin), "vkBeginCommandBuffer");
+            if (timed && p.queries) {
+                vkCmdResetQueryPool(cmd, p.queries, 0, 2);
+                vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, p.queries, 0);
+            }
+            record(cmd);
+            if (timed && p.queries) vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, p.queries, 1);
+            check(vkEndCommandBuffer(cmd), "vkEndCommandBuffer");
+            const auto start = Clock::now();
+            VkSubmitInfo info{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+            info.commandBufferCount = 1;
+            info.pCommandBuffers = &cmd;
+            check(vkQueueSubmit(context_.queue(), 1, &info, p.fence), "vkQueueSubmit");
+            check(vkWaitForFences(device, 1, &p.fence, VK_TRUE, UINT64_MAX), "vkWaitForFences");
+            check(vkResetFences(device, 1, &p.fence), "vkResetFences");
+            if (timed) {
+                hostRenderMs += msSince(start);
+                if (p.queries) {
+                    std::uint64_t stamps[2] = {0, 0};
+                    check(vkGetQueryPoolResults(device, p.queries, 0, 2, sizeof stamps, stamps, sizeof(std::uint64_t),
+                                                VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
+                          "vkGetQueryPoolResults");
+                    gpuRenderMs += double(stamps[1] - stamps[0]) * context_.properties().limits.timestampPeriod * 1e-6;
+                }
+            }
+        };
 
         const int tilesX = (request.width + tileW - 1) / tileW;
         const int tilesY = (request.height + tileH - 1) / tileH;
         const int tileCount = tilesX * tilesY;
-        double hostRenderMs = 0.0, gpuRenderMs = 0.0;
-        bool first = true;
+        auto* counters = static_cast<std::uint32_t*>(p.counters.mapped);
+        bool imageUsed = false;
         for (int ty = 0; ty < tilesY; ++ty) {
             for (int tx = 0; tx < tilesX; ++tx) {
-                if (request.cancel && request.cancel->load()) throw vk::VulkanError("render cancelled");
                 gpu::TileParams tile{std::uint32_t(tx * tileW), std::uint32_t(ty * tileH),
                                      std::uint32_t(std::min(tileW, request.width - tx * tileW)),
                                      std::uint32_t(std::min(tileH, request.height - ty * tileH))};
-                std::memset(p.counters.mapped, 0, SNELL_COUNTER_COUNT * sizeof(std::uint32_t));
-                VkCommandBuffer cmd = p.commands;
-                check(vkResetCommandBuffer(cmd, 0), "vkResetCommandBuffer");
-                VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
-                begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-                check(vkBeginCommandBuffer(cmd, &begin), "vkBeginCommandBuffer");
-                VkImageMemoryBarrier toGeneral{VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER};
-                toGeneral.srcAccessMask = first ? 0 : VK_ACCESS_TRANSFER_READ_BIT;
-                toGeneral.dstAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
-                toGeneral.oldLayout = first ? VK_IMAGE_LAYOUT_UNDEFINED : VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
-                toGeneral.newLayout = VK_IMAGE_LAYOUT_GENERAL;
-                toGeneral.srcQueueFamilyIndex = toGeneral.dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED;
-                toGeneral.image = p.image.image;
-                toGeneral.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
-                vkCmdPipelineBarrier(cmd, first ? VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT : VK_PIPELINE_STAGE_TRANSFER_BIT,
-                                     VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, 0, 0, nullptr, 0, nullptr, 1, &toGeneral);
-                first = false;
-                if (p.queries) {
-                    vkCmdResetQueryPool(cmd, p.queries, 0, 2);
-                    vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, p.queries, 0);
+                const std::uint32_t groupsX = (tile.width + SNELL_WORKGROUP_SIZE_X - 1) / SNELL_WORKGROUP_SIZE_X;
+                const std::uint32_t groupsY = (tile.height + SNELL_WORKGROUP_SIZE_Y - 1) / SNELL_WORKGROUP_SIZE_Y;
+                // Dispatch until every pixel of the tile has finished its ray
+                // trees; each dispatch resumes where the last one stopped.
+                for (int pass = 0;; ++pass) {
+                    if (request.cancel && request.cancel->load()) throw vk::VulkanError("render cancelled");
+                    std::memset(counters, 0, SNELL_COUNTER_COUNT * sizeof(std::uint32_t));
+                    submit([&](VkCommandBuffer cmd) {
+                        if (pass == 0) {
+                            vkCmdFillBuffer(cmd, p.pixelStates.buffer, 0, VK_WHOLE_SIZE, 0);
+                            memoryBarrier(cmd, VK_ACCESS_TRANSFER_WRITE_BIT,
+                                          VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT,
+                                          VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
+                            imageBarrier(cmd, p.image.image,
+                                         imageUsed ? VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL : VK_IMAGE_LAYOUT_UNDEFINED,
+                                         VK_IMAGE_LAYOUT_GENERAL, imageUsed ? VK_ACCESS_TRANSFER_READ_BIT : 0,
+                                         VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
+                                         VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
+                        } else {
+                            // The previous dispatch's pixel states and stacks.
+                            memoryBarrier(cmd, VK_ACCESS_SHADER_WRITE_BIT,
+                                          VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT,
+                                          VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
+                        }
+                        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.pipeline);
+                        vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.layout, 0, 1, &p.set, 0, nullptr);
+                        vkCmdPushConstants(cmd, p.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof tile, &tile);
+                        vkCmdDispatch(cmd, groupsX, groupsY, 1);
+                        memoryBarrier(cmd, VK_ACCESS_SHADER_WRITE_BIT, VK_ACCESS_HOST_READ_BIT,
+                                      VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT);
+                    }, true);
+                    imageUsed = true;
+                    ++result.dispatches;
+                    if (counters[SNELL_COUNTER_LOOP_LIMIT] != 0)
+                        throw vk::VulkanError("a single ray needed more loop iterations than lavapipe allows in one "
+                                              "dispatch (65535 per SIMD row); the image would be wrong. Try fewer "
+                                              "lights or a smaller --depth");
+                    if (countRays) {
+                        result.rays.primary += counters[SNELL_COUNTER_PRIMARY];
+                        result.rays.shadow += counters[SNELL_COUNTER_SHADOW];
+                        result.rays.reflected += counters[SNELL_COUNTER_REFLECTED];
+                        result.rays.refracted += counters[SNELL_COUNTER_REFRACTED];
+                    }
+                    const std::uint32_t unfinished = counters[SNELL_COUNTER_UNFINISHED];
+                    if (request.progress)
+                        request.progress((result.tiles + 1.0 - double(unfinished) / double(tile.width * tile.height)) /
+                                         tileCount);
+                    if (unfinished == 0) break;
                 }
-                vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.pipeline);
-                vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.layout, 0, 1, &p.set, 0, nullptr);
-                vkCmdPushConstants(cmd, p.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof tile, &tile);
-                vkCmdDispatch(cmd, (tile.width + SNELL_WORKGROUP_SIZE_X - 1) / SNELL_WORKGROUP_SIZE_X,
-                              (tile.height + SNELL_WORKGROUP_SIZE_Y - 1) / SNELL_WORKGROUP_SIZE_Y, 1);
-                if (p.queries) vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, p.queries, 1);
-                VkImageMemoryBarrier toCopy = toGeneral;
-                toCopy.srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT;
-                toCopy.dstAccessMask = VK_ACCESS_TRANSFER_READ_BIT;
-                toCopy.oldLayout = VK_IMAGE_LAYOUT_GENERAL;
-                toCopy.newLayout = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
-                vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0, 0,
-                                     nullptr, 0, nullptr, 1, &toCopy);
-                VkBufferImageCopy region{};
-                region.bufferRowLength = tileW;
-                region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-                region.imageExtent = {tile.width, tile.height, 1};
-                vkCmdCopyImageToBuffer(cmd, p.image.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, p.readback.buffer, 1, &region);
-                VkMemoryBarrier toHost{VK_STRUCTURE_TYPE_MEMORY_BARRIER};
-                toHost.srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_SHADER_WRITE_BIT;
-                toHost.dstAccessMask = VK_ACCESS_HOST_READ_BIT;
-                vkCmdPipelineBarrier(cmd, VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-                                     VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &toHost, 0, nullptr, 0, nullptr);
-                check(vkEndCommandBuffer(cmd), "vkEndCommandBuffer");
-
-                const auto submitStart = Clock::now();
-                VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
-                submit.commandBufferCount = 1;
-                submit.pCommandBuffers = &cmd;
-                check(vkQueueSubmit(context_.queue(), 1, &submit, p.fence), "vkQueueSubmit");
-                check(vkWaitForFences(context_.device(), 1, &p.fence, VK_TRUE, UINT64_MAX), "vkWaitForFences");
-                check(vkResetFences(context_.device(), 1, &p.fence), "vkResetFences");
-                hostRenderMs += msSince(submitStart);
-                if (p.queries) {
-                    std::uint64_t stamps[2] = {0, 0};
-                    check(vkGetQueryPoolResults(context_.device(), p.queries, 0, 2, sizeof stamps, stamps,
-                                                sizeof(std::uint64_t), VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
-                          "vkGetQueryPoolResults");
-                    gpuRenderMs += double(stamps[1] - stamps[0]) * context_.properties().limits.timestampPeriod * 1e-6;
-                }
+                // Copy the finished tile back.
+                submit([&](VkCommandBuffer cmd) {
+                    imageBarrier(cmd, p.image.image, VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                                 VK_ACCESS_SHADER_WRITE_BIT, VK_ACCESS_TRANSFER_READ_BIT,
+                                 VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT);
+                    VkBufferImageCopy region{};
+                    region.bufferRowLength = tileW;
+                    region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
+                    region.imageExtent = {tile.width, tile.height, 1};
+                    vkCmdCopyImageToBuffer(cmd, p.image.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, p.readback.buffer,
+                                           1, &region);
+                    memoryBarrier(cmd, VK_ACCESS_TRANSFER_WRITE_BIT, VK_ACCESS_HOST_READ_BIT,
+                                  VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT);
+                }, false);
                 const auto readStart = Clock::now();
                 const auto* texels = static_cast<const float*>(p.readback.mapped);
                 for (std::uint32_t y = 0; y < tile.height; ++y) {
@@ -311,16 +399,8 @@ GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool count
                         row[x * 3 + 2] = src[x * 4 + 2];
                     }
                 }
-                if (countRays) {
-                    const auto* c = static_cast<const std::uint32_t*>(p.counters.mapped);
-                    result.rays.primary += c[SNELL_COUNTER_PRIMARY];
-                    result.rays.shadow += c[SNELL_COUNTER_SHADOW];
-                    result.rays.reflected += c[SNELL_COUNTER_REFLECTED];
-                    result.rays.refracted += c[SNELL_COUNTER_REFRACTED];
-                }
                 result.readbackMs += msSince(readStart);
                 ++result.tiles;
-                if (request.progress) request.progress(double(result.tiles) / tileCount);
             }
         }
         result.gpuTimed = p.queries != VK_NULL_HANDLE;

@@ -20,6 +20,7 @@ struct GpuRenderResult {
     double pipelineMs = 0.0;  // shader pipeline creation
     double readbackMs = 0.0;  // copying tiles back into the image
     int tiles = 0;
+    int dispatches = 0;       // pixels resume across dispatches (see shared_layout.h)
 };
 
 class ComputeRenderer {

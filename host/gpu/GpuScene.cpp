@@ -44,12 +44,35 @@ GpuScene buildGpuScene(const snell::Scene& scene, const snell::Camera& camera) {
         bounds.reserve(scene.spheres.size());
         for (const snell::Sphere& s : scene.spheres) bounds.push_back(snell::sphereBounds(s));
         const snell::Bvh bvh = snell::buildBvh(bounds);
+        // Depth-first (pre-order) layout with skip links: stackless traversal.
         out.nodes.reserve(bvh.nodes.size());
-        for (const snell::BvhNode& n : bvh.nodes) {
+        std::vector<std::uint32_t> gpuIndexOf(bvh.nodes.size(), 0);
+        std::vector<std::uint32_t> preorder;
+        preorder.reserve(bvh.nodes.size());
+        std::vector<std::uint32_t> stack{0};
+        while (!stack.empty()) {
+            const std::uint32_t n = stack.back();
+            stack.pop_back();
+            gpuIndexOf[n] = static_cast<std::uint32_t>(preorder.size());
+            preorder.push_back(n);
+            if (bvh.nodes[n].count == 0) {
+                stack.push_back(bvh.nodes[n].first + 1);
+                stack.push_back(bvh.nodes[n].first);
+            }
+        }
+        // Subtree sizes give the skip links: skip = own index + subtree size.
+        std::vector<std::uint32_t> subtree(bvh.nodes.size(), 1);
+        for (auto it = preorder.rbegin(); it != preorder.rend(); ++it) {
+            const snell::BvhNode& n = bvh.nodes[*it];
+            if (n.count == 0) subtree[*it] = 1 + subtree[n.first] + subtree[n.first + 1];
+        }
+        for (std::uint32_t n : preorder) {
+            const snell::BvhNode& b = bvh.nodes[n];
             BvhNode node{};
-            outwardBox(n.bounds, eye, node.lower, node.upper);
-            node.first = n.first;
-            node.count = n.count;
+            outwardBox(b.bounds, eye, node.lower, node.upper);
+            node.first = b.count > 0 ? b.first : 0;
+            node.count = b.count;
+            node.skip = gpuIndexOf[n] + subtree[n];
             out.nodes.push_back(node);
         }
         order = bvh.order;

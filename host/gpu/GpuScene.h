@@ -16,10 +16,13 @@ static_assert(sizeof(Sphere) == 32 && offsetof(Sphere, material) == 16 && offset
 static_assert(sizeof(Ellipsoid) == 64);
 static_assert(sizeof(Material) == 48 && offsetof(Material, kt) == 32);
 static_assert(sizeof(Light) == 32 && offsetof(Light, colour) == 16);
-static_assert(sizeof(BvhNode) == 48 && offsetof(BvhNode, first) == 32 && offsetof(BvhNode, count) == 36);
+static_assert(sizeof(BvhNode) == 48 && offsetof(BvhNode, first) == 32 && offsetof(BvhNode, count) == 36 &&
+              offsetof(BvhNode, skip) == 40);
 static_assert(sizeof(FrameParams) == 112 && offsetof(FrameParams, imageWidth) == 80 &&
               offsetof(FrameParams, bvhNodeCount) == 104);
 static_assert(sizeof(TileParams) == 16);
+static_assert(sizeof(PixelState) == 32 && offsetof(PixelState, started) == 16);
+static_assert(sizeof(PendingRay) == 64 && offsetof(PendingRay, depth) == 48 && offsetof(PendingRay, mediaCount) == 60);
 
 // Spheres above this count are traversed through the BVH; fewer are tested in a loop.
 inline constexpr std::size_t kBvhThreshold = 8;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <optional>
 #include <thread>
 #include <vector>
 
@@ -217,7 +218,9 @@ void CpuRenderer::trace(const PendingRay& primary, dvec3& pixelSum, double satur
         if (r.depth >= settings.maxDepth) continue;
 
         // 4–5. Children: reflection, and refraction through the medium stack.
+        // Pushed reflection first, so refraction is traced next (as the shader).
         dvec3 reflectedWeight = r.weight * m.ks;
+        std::optional<PendingRay> refractedRay;
         if (m.refracts()) {
             const dvec3 transmittedWeight = r.weight * m.kt;
             MediumStack media = r.media;
@@ -237,15 +240,18 @@ void CpuRenderer::trace(const PendingRay& primary, dvec3& pixelSum, double satur
                 // medium: one ray carrying both weights (exactly SPEC §4.5).
                 reflectedWeight += transmittedWeight;
             } else if (worthTracing(transmittedWeight)) {
-                ++counts.refracted;
-                stack.push_back({{x, refracted}, transmittedWeight, r.depth + 1, hit.sphere,
-                                 fromOutside, true, media});
+                refractedRay = PendingRay{{x, refracted}, transmittedWeight, r.depth + 1, hit.sphere,
+                                          fromOutside, true, media};
             }
         }
         if (worthTracing(reflectedWeight)) {
             ++counts.reflected;
             stack.push_back({{x, reflectDirection(d, n)}, reflectedWeight, r.depth + 1, hit.sphere,
                              !fromOutside, false, r.media});
+        }
+        if (refractedRay) {
+            ++counts.refracted;
+            stack.push_back(*refractedRay);
         }
     }
 }

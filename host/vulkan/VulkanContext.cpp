@@ -85,6 +85,15 @@ DeviceReport examine(VkPhysicalDevice device, int index, std::uint32_t& family,
             return report;
         }
     }
+    VkPhysicalDeviceSubgroupProperties subgroup{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES};
+    VkPhysicalDeviceProperties2 withSubgroup{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, &subgroup};
+    vkGetPhysicalDeviceProperties2(device, &withSubgroup);
+    const VkSubgroupFeatureFlags needed =
+        VK_SUBGROUP_FEATURE_BASIC_BIT | VK_SUBGROUP_FEATURE_VOTE_BIT | VK_SUBGROUP_FEATURE_ARITHMETIC_BIT;
+    if (!(subgroup.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) || (subgroup.supportedOperations & needed) != needed) {
+        report.reason = "lacks basic, vote and arithmetic subgroup operations in compute shaders";
+        return report;
+    }
     VkFormatProperties format;
     vkGetPhysicalDeviceFormatProperties(device, VK_FORMAT_R32G32B32A32_SFLOAT, &format);
     if (!(format.optimalTilingFeatures & VK_FORMAT_FEATURE_STORAGE_IMAGE_BIT)) {
@@ -248,6 +257,10 @@ Context::Context(const ContextOptions& options) {
         deviceName_ = reports_[best].name;
         driverInfo_ = reports_[best].driver;
         vkGetPhysicalDeviceProperties(physical_, &properties_);
+        VkPhysicalDeviceDriverProperties driver{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES};
+        VkPhysicalDeviceProperties2 props2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, &driver};
+        vkGetPhysicalDeviceProperties2(physical_, &props2);
+        driverId_ = driver.driverID;
         vkGetPhysicalDeviceMemoryProperties(physical_, &memory_);
         std::uint32_t count = 0;
         vkGetPhysicalDeviceQueueFamilyProperties(physical_, &count, nullptr);

@@ -82,6 +82,9 @@ public:
     const std::string& driverInfo() const { return driverInfo_; }
     bool timestampsSupported() const { return timestampValidBits_ > 0 && properties_.limits.timestampComputeAndGraphics; }
     bool float64Supported() const { return float64_; }
+    // Mesa's llvmpipe (lavapipe): its shaders end all loops after 65535
+    // iterations per SIMD row and dispatch, which the renderer works around.
+    bool isLlvmpipe() const { return driverId_ == VK_DRIVER_ID_MESA_LLVMPIPE; }
     // Validation-layer errors and warnings reported so far.
     std::uint32_t validationMessages() const { return validationMessages_; }
     const std::vector<DeviceReport>& deviceReports() const { return reports_; }
@@ -127,6 +130,7 @@ private:
     std::uint32_t queueFamily_ = 0;
     std::uint32_t timestampValidBits_ = 0;
     bool float64_ = false;
+    VkDriverId driverId_{};
     VkPhysicalDeviceProperties properties_{};
     VkPhysicalDeviceMemoryProperties memory_{};
     std::string deviceName_;
