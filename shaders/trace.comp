@@ -60,7 +60,14 @@ void tick() {
 
 // ---------------------------------------------------------------------------
 // Intersection: Haines et al. (Ray Tracing Gems ch. 7) roots; exact chord root
-// for a ray entering the sphere it starts on, no hit for one leaving it.
+// for a ray entering the sphere it starts on, no hit for one leaving it. A ray
+// that starts within rounding distance of another sphere's surface (a hit
+// point on a touching or overlapping sphere) starts just outside it: it hits
+// it at once if it heads in, and misses it if it heads out. Without that rule
+// the sign of |f|² − r² is noise there and seams of overlapping spheres come
+// out speckled (see host/reference/Intersect.h, the double twin).
+
+const float ROUNDING = 4.0 * 5.96e-8;  // 4 units of float32 rounding (2^-24)
 
 float rootsToHit(float b, float a, float c, float discriminant) {
     // q-form: q = −(b + sign(b)·√Δ); roots c/q and q/a, no cancellation.
@@ -71,6 +78,11 @@ float rootsToHit(float b, float a, float c, float discriminant) {
     float near = min(t0, t1);
     float far = max(t0, t1);
     return near > 0.0 ? near : (far > 0.0 ? far : NO_HIT);
+}
+
+// `distanceToSurface` and `tolerance` in the same units; b < 0: heading in.
+bool startsOnSurface(float distanceToSurface, float tolerance) {
+    return abs(distanceToSurface) <= tolerance;
 }
 
 float intersectSphere(uint index, vec3 origin, vec3 dir, uint fromSphere, uint start) {
@@ -90,6 +102,13 @@ float intersectSphere(uint index, vec3 origin, vec3 dir, uint fromSphere, uint s
         vec3 perpendicular = o - (b / a) * d;
         float discriminant = a * (1.0 - dot(perpendicular, perpendicular));
         if (discriminant < 0.0) return NO_HIT;
+        float lengthO = length(o);
+        // Rounding of o: of the origin through the matrix, and of the product.
+        mat3 m = mat3(objectFromWorld);
+        float matrixNorm = max(max(abs(m[0].x) + abs(m[1].x) + abs(m[2].x), abs(m[0].y) + abs(m[1].y) + abs(m[2].y)),
+                               abs(m[0].z) + abs(m[1].z) + abs(m[2].z));
+        if (startsOnSurface(lengthO - 1.0, ROUNDING * (lengthO + 1.0 + matrixNorm * length(origin))))
+            return b < 0.0 ? 0.0 : NO_HIT;
         return rootsToHit(b, a, dot(o, o) - 1.0, discriminant);
     }
     vec3 f = origin - s.centreRadius.xyz;
@@ -102,6 +121,9 @@ float intersectSphere(uint index, vec3 origin, vec3 dir, uint fromSphere, uint s
     vec3 perpendicular = f - b * dir;
     float discriminant = r * r - dot(perpendicular, perpendicular);
     if (discriminant < 0.0) return NO_HIT;
+    float lengthF = length(f);
+    if (startsOnSurface(lengthF - r, ROUNDING * (length(origin) + length(s.centreRadius.xyz) + r)))
+        return b < 0.0 ? 0.0 : NO_HIT;
     return rootsToHit(b, 1.0, dot(f, f) - r * r, discriminant);
 }
 
@@ -275,19 +297,19 @@ void traceOneRay(uint pixel, inout PixelState state, float saturation) {
     Material m = materials[s.material];
 
     // 2. Hit point; outward normal No and shading normal N.
-    vec3 x, outward;
+    // The hit point is o + t d, not re-projected onto the surface: re-projecting
+    // (centre + r n̂, or normalising the object-space point) rounds at the scale
+    // of the centre or of the largest semi-axis, which for a big floor sphere
+    // near the camera is 100× the error of o + t d. Self-intersection needs no
+    // point exactly on the surface (see intersectSphere).
+    vec3 x = o + t * d;
+    vec3 outward;
     if (HAS_ELLIPSOIDS && s.ellipsoid != SNELL_NOT_ELLIPSOID) {
-        // No re-projection: normalising p would spread the rounding of its
-        // largest component (huge for a flat ellipsoid seen edge-on) into the
-        // others. o + t d is as exact as float allows.
         mat4 objectFromWorld = ellipsoids[s.ellipsoid].objectFromWorld;
         vec3 p = (objectFromWorld * vec4(o, 1.0)).xyz + t * (mat3(objectFromWorld) * d);
-        x = o + t * d;
         outward = normalize(transpose(mat3(objectFromWorld)) * p);
     } else {
-        // Re-projected onto the sphere.
         outward = normalize(o - s.centreRadius.xyz + t * d);
-        x = s.centreRadius.xyz + s.centreRadius.w * outward;
     }
     bool fromOutside = dot(d, outward) < 0.0;
     vec3 n = fromOutside ? outward : -outward;

@@ -275,9 +275,9 @@ int main(int argc, char** argv) {
     render->add_flag("--cpu", ro.cpu, "Render with the double-precision CPU reference instead of the GPU");
     render->add_option("-s,--size", ro.size, "Image size in pixels (overrides the scene's view n)")
         ->check(CLI::Range(1, snell::ParseLimits::kMaxImageSize));
-    render->add_option("-d,--depth", ro.depth, "Maximum reflection/refraction depth (default: GPU 32, CPU 64)")
+    render->add_option("-d,--depth", ro.depth, "Maximum reflection/refraction depth (default: 64)")
         ->check(CLI::Range(0, 100000));
-    render->add_option("--min-weight", ro.minWeight, "Stop rays whose weight falls below W; 0 disables (default: GPU 5e-4, CPU 1e-7)")
+    render->add_option("--min-weight", ro.minWeight, "Stop rays whose weight falls below W; 0 disables (default: GPU 1e-4, CPU 1e-7)")
         ->check(CLI::Range(0.0, 1.0));
     render->add_option("--spp,--supersample", ro.supersample, "Rays per pixel per axis (overrides the scene's supersample)")
         ->check(CLI::Range(1, snell::ParseLimits::kMaxSupersample));

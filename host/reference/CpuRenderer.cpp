@@ -92,8 +92,14 @@ double CpuRenderer::intersect(std::uint32_t index, const Ray& ray, std::uint32_t
     const StartsOn mode = index == fromSphere ? start : StartsOn::Elsewhere;
     if (s.isTrueSphere) return intersectSphere(s.centre, s.radius, ray, mode);
     const dvec3 o = dvec3(s.objectFromWorld * glm::dvec4(ray.origin, 1.0));
-    const dvec3 d = glm::dmat3(s.objectFromWorld) * ray.direction;
-    return intersectUnitSphere(o, d, mode);
+    const glm::dmat3 m(s.objectFromWorld);
+    const dvec3 d = m * ray.direction;
+    // Rounding of o: of the origin through the matrix, and of the product.
+    double matrixNorm = 0.0;
+    for (int row = 0; row < 3; ++row)
+        matrixNorm = std::max(matrixNorm, std::abs(m[0][row]) + std::abs(m[1][row]) + std::abs(m[2][row]));
+    const double tolerance = kRounding * (glm::length(o) + 1.0 + matrixNorm * glm::length(ray.origin));
+    return intersectUnitSphere(o, d, mode, tolerance);
 }
 
 bool CpuRenderer::closestHit(const Ray& ray, std::uint32_t fromSphere, StartsOn start, Hit& hit) const {
@@ -179,17 +185,15 @@ void CpuRenderer::trace(const PendingRay& primary, dvec3& pixelSum, double satur
         const Sphere& sphere = scene_.spheres[hit.sphere];
         const Material& m = scene_.materials[sphere.material];
 
-        // 2. Hit point re-projected onto the surface, outward normal No, shading normal N.
-        dvec3 x, outward;
+        // 2. Hit point, outward normal No, shading normal N.
+        // The hit point is o + t d, not re-projected (see trace.comp).
+        const dvec3 x = r.ray.origin + hit.t * r.ray.direction;
+        dvec3 outward;
         if (sphere.isTrueSphere) {
             outward = glm::normalize(r.ray.origin - sphere.centre + hit.t * r.ray.direction);
-            x = sphere.centre + sphere.radius * outward;
         } else {
             const dvec3 o = dvec3(sphere.objectFromWorld * glm::dvec4(r.ray.origin, 1.0));
-            const dvec3 d = glm::dmat3(sphere.objectFromWorld) * r.ray.direction;
-            // As in the shader: no re-projection for ellipsoids (see trace.comp).
-            const dvec3 p = o + hit.t * d;
-            x = r.ray.origin + hit.t * r.ray.direction;
+            const dvec3 p = o + hit.t * (glm::dmat3(sphere.objectFromWorld) * r.ray.direction);
             outward = glm::normalize(glm::transpose(glm::dmat3(sphere.objectFromWorld)) * p);
         }
         const dvec3 d = r.ray.direction;

@@ -8,6 +8,13 @@
 // that starts on a sphere's surface either leaves the convex sphere (that
 // sphere cannot be hit again) or enters it, and then its only hit is the exact
 // chord root t = −2 (o·d)/(d·d), the non-zero root when o is on the surface.
+// A ray that starts within rounding distance of *another* sphere's surface (a
+// hit point on a touching or overlapping sphere) is taken to start just
+// outside it: it hits it at t = 0 if it heads in (o·d < 0) and misses it if it
+// heads out. The hit point lies on the closest surface along its ray, so in
+// exact arithmetic it is outside every sphere it did not hit; only rounding can
+// put it inside, and then the sign of |o|² − 1 is noise that would speckle the
+// seams of overlapping spheres with false shadows.
 #pragma once
 
 #include <cmath>
@@ -26,10 +33,14 @@ struct Ray {
 enum class StartsOn { Elsewhere, Leaving, Entering };
 
 inline constexpr double kNoHit = std::numeric_limits<double>::infinity();
+// Four units of double rounding: the band around a surface within which a ray
+// origin counts as on it.
+inline constexpr double kRounding = 4.0 * std::numeric_limits<double>::epsilon() / 2.0;
 
 // Smallest root t > 0 of |o + t d|^2 = 1 for the unit sphere, given o and d in
 // the sphere's own frame (d not necessarily unit); kNoHit if none.
-inline double intersectUnitSphere(const glm::dvec3& o, const glm::dvec3& d, StartsOn start) {
+// `tolerance`: how far (object units) rounding may have put o off the surface.
+inline double intersectUnitSphere(const glm::dvec3& o, const glm::dvec3& d, StartsOn start, double tolerance = 0.0) {
     const double a = glm::dot(d, d);
     const double b = glm::dot(o, d);
     if (start == StartsOn::Leaving) return kNoHit;
@@ -40,6 +51,7 @@ inline double intersectUnitSphere(const glm::dvec3& o, const glm::dvec3& d, Star
     const glm::dvec3 perpendicular = o - (b / a) * d;
     const double discriminant = a * (1.0 - glm::dot(perpendicular, perpendicular));
     if (discriminant < 0.0) return kNoHit;
+    if (std::abs(glm::length(o) - 1.0) <= tolerance) return b < 0.0 ? 0.0 : kNoHit;
     const double q = -(b + std::copysign(std::sqrt(discriminant), b));
     if (q == 0.0) return kNoHit;
     const double c = glm::dot(o, o) - 1.0;
@@ -53,6 +65,7 @@ inline double intersectUnitSphere(const glm::dvec3& o, const glm::dvec3& d, Star
 // The same for a true sphere (centre, radius) and a unit direction: the unit
 // sphere's equation scaled by r, so a = 1 and o is relative to the centre.
 inline double intersectSphere(const glm::dvec3& centre, double radius, const Ray& ray, StartsOn start) {
+    const double tolerance = kRounding * (glm::length(ray.origin) + glm::length(centre) + radius);
     const glm::dvec3 f = ray.origin - centre;
     const double b = glm::dot(f, ray.direction);
     if (start == StartsOn::Leaving) return kNoHit;
@@ -63,6 +76,7 @@ inline double intersectSphere(const glm::dvec3& centre, double radius, const Ray
     const glm::dvec3 perpendicular = f - b * ray.direction;
     const double discriminant = radius * radius - glm::dot(perpendicular, perpendicular);
     if (discriminant < 0.0) return kNoHit;
+    if (std::abs(glm::length(f) - radius) <= tolerance) return b < 0.0 ? 0.0 : kNoHit;
     const double q = -(b + std::copysign(std::sqrt(discriminant), b));
     if (q == 0.0) return kNoHit;
     const double c = glm::dot(f, f) - radius * radius;

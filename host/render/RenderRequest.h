@@ -18,7 +18,7 @@ struct TraceSettings {
 // The converged settings used to compute the exact image (SPEC §4).
 inline constexpr TraceSettings kReferenceSettings{64, 1e-7};
 // What `snell render` uses unless told otherwise (see README, "Defaults").
-inline constexpr TraceSettings kDefaultSettings{32, 5e-4};
+inline constexpr TraceSettings kDefaultSettings{64, 1e-4};
 
 struct RayCounts {
     std::uint64_t primary = 0;
