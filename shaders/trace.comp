@@ -260,35 +260,60 @@ vec3 shade(Material m, vec3 x, vec3 n, vec3 v, uint hitSphere, bool fromOutside)
     return local;
 }
 
-// The medium a ray is in: the innermost sphere of its stack, or air.
-float mediumEta(uint mediaBase, uint count) {
-    return count == 0u ? frame.background.w
-                       : materials[spheres[mediaStack[mediaBase + count - 1u]].material].kt.w;
-}
+// The ray being traced lives in registers; only a deferred child (the
+// reflected one, when a ray also refracts) goes to the pixel's stack in
+// device memory, and so does the current ray when the pixel suspends.
+struct Ray {
+    vec3 origin;
+    vec3 dir;
+    vec3 weight;      // product of the ks/kt factors along its path
+    uint depth;
+    uint fromSphere;  // the sphere whose surface it starts on
+    bool inward;      // it heads into that sphere
+    uint mediaCount;  // its medium stack is `media`, innermost last
+};
+uint media[MAX_MEDIA];
 
-void pushRay(uint pixel, inout PixelState state, vec3 origin, vec3 dir, vec3 weight, uint depth,
-             uint fromSphere, bool inward, uint mediaCount) {
+float etaOfSphere(uint sphere) { return materials[spheres[sphere].material].kt.w; }
+
+void pushRay(uint pixel, inout PixelState state, Ray r) {
     uint slot = pixel * uint(RAY_STACK) + state.pending;
-    rayStack[slot] = PendingRay(vec4(origin, 0.0), vec4(dir, 0.0), vec4(weight, 0.0), depth, fromSphere,
-                                inward ? 1u : 0u, mediaCount);
+    rayStack[slot] = PendingRay(vec4(r.origin, 0.0), vec4(r.dir, 0.0), vec4(r.weight, 0.0), r.depth, r.fromSphere,
+                                r.inward ? 1u : 0u, r.mediaCount);
+    tick();
+    for (uint k = 0u; k < r.mediaCount; ++k) {
+        tick();
+        mediaStack[slot * uint(MAX_MEDIA) + k] = media[k];
+    }
     state.pending++;
 }
 
-// Trace the ray on top of the pixel's stack: closest hit, local term, and its
-// children pushed (reflection first, so refraction is traced next).
-void traceOneRay(uint pixel, inout PixelState state, float saturation) {
+Ray popRay(uint pixel, inout PixelState state) {
     state.pending--;
     uint slot = pixel * uint(RAY_STACK) + state.pending;
-    PendingRay r = rayStack[slot];
-    vec3 o = r.origin.xyz;
-    vec3 d = r.direction.xyz;
-    vec3 weight = r.weight.rgb;
+    PendingRay p = rayStack[slot];
+    tick();
+    for (uint k = 0u; k < p.mediaCount; ++k) {
+        tick();
+        media[k] = mediaStack[slot * uint(MAX_MEDIA) + k];
+    }
+    return Ray(p.origin.xyz, p.direction.xyz, p.weight.rgb, p.depth, p.fromSphere, p.inward != 0u, p.mediaCount);
+}
+
+// Trace ray r: closest hit, local term, children. On return r is the child
+// to trace next (hasRay), the other child having been pushed on the stack;
+// refraction is traced first, as in the CPU reference.
+void traceRay(uint pixel, inout PixelState state, inout Ray r, out bool hasRay, float saturation) {
+    hasRay = false;
+    vec3 weight = r.weight;
     if (AMPLIFYING) weight = mix(weight, vec3(0.0), greaterThanEqual(state.sum.rgb, vec3(saturation)));
     if (!worthTracing(weight)) return;
+    vec3 o = r.origin;
+    vec3 d = r.dir;
 
     // 1. Closest hit.
     float t;
-    uint hitSphere = closestHit(o, d, r.fromSphere, r.inward != 0u ? ENTERING : LEAVING, t);
+    uint hitSphere = closestHit(o, d, r.fromSphere, r.inward ? ENTERING : LEAVING, t);
     if (hitSphere == NONE) {
         state.sum.rgb += weight * frame.background.rgb;
         return;
@@ -296,12 +321,11 @@ void traceOneRay(uint pixel, inout PixelState state, float saturation) {
     Sphere s = spheres[hitSphere];
     Material m = materials[s.material];
 
-    // 2. Hit point; outward normal No and shading normal N.
-    // The hit point is o + t d, not re-projected onto the surface: re-projecting
-    // (centre + r n̂, or normalising the object-space point) rounds at the scale
-    // of the centre or of the largest semi-axis, which for a big floor sphere
-    // near the camera is 100× the error of o + t d. Self-intersection needs no
-    // point exactly on the surface (see intersectSphere).
+    // 2. Hit point o + t d, not re-projected onto the surface: re-projecting
+    // (centre + r n̂, or normalising the object-space point) rounds at the
+    // scale of the centre or of the largest semi-axis, which for a big floor
+    // sphere near the camera is 100× the error of o + t d. Self-intersection
+    // needs no point exactly on the surface (see intersectSphere).
     vec3 x = o + t * d;
     vec3 outward;
     if (HAS_ELLIPSOIDS && s.ellipsoid != SNELL_NOT_ELLIPSOID) {
@@ -318,48 +342,35 @@ void traceOneRay(uint pixel, inout PixelState state, float saturation) {
     state.sum.rgb += weight * shade(m, x, n, -d, hitSphere, fromOutside);
     if (r.depth >= frame.maxDepth) return;
 
-    // 4. Reflection and 5. refraction. The popped slot's media stay in place
-    // for the reflected child; a refracted child's media go in its own slot.
+    // 4. Reflection (keeps the medium stack) and 5. refraction.
     vec3 reflectedWeight = HAS_REFLECTION ? weight * m.ks.rgb : vec3(0.0);
-    uint parentMedia = slot * uint(MAX_MEDIA);
+    bool refracts = false;
+    vec3 refracted = vec3(0.0);
+    vec3 transmittedWeight = vec3(0.0);
+    uint removeAt = r.mediaCount;  // leaving: where this sphere is in the stack
     if (HAS_REFRACTION && max(m.kt.r, max(m.kt.g, m.kt.b)) > 0.0) {
-        vec3 transmittedWeight = weight * m.kt.rgb;
-        uint count = r.mediaCount;
+        transmittedWeight = weight * m.kt.rgb;
         float etaI, etaT;
-        // The refracted child takes the slot above the reflected one.
-        uint childMedia = parentMedia + uint(MAX_MEDIA);
-        uint childCount = 0u;
         if (fromOutside) {
-            // Entering: this sphere becomes the innermost medium.
-            etaI = mediumEta(parentMedia, count);
+            // Entering: from the current medium into this sphere.
+            etaI = r.mediaCount == 0u ? frame.background.w : etaOfSphere(media[r.mediaCount - 1u]);
             etaT = m.kt.w;
-            uint first = count == uint(MAX_MEDIA) ? 1u : 0u;  // full: forget the outermost
-            tick();
-            for (uint k = first; k < count; ++k) {
-                tick();
-                mediaStack[childMedia + childCount] = mediaStack[parentMedia + k];
-                childCount++;
-            }
-            mediaStack[childMedia + childCount] = hitSphere;
-            childCount++;
         } else {
-            // Leaving: remove this sphere wherever it is (innermost occurrence).
+            // Leaving: into the medium that remains once this sphere is removed
+            // from the stack (its innermost occurrence; none: nothing removed).
             etaI = m.kt.w;
-            uint innermost = count;
             tick();
-            for (uint k = 0u; k < count; ++k) {
+            for (uint k = 0u; k < r.mediaCount; ++k) {
                 tick();
-                if (mediaStack[parentMedia + k] == hitSphere) innermost = k;
+                if (media[k] == hitSphere) removeAt = k;
             }
+            uint innermost = r.mediaCount;  // the innermost one that stays
             tick();
-            for (uint k = 0u; k < count; ++k) {
+            for (uint k = 0u; k < r.mediaCount; ++k) {
                 tick();
-                if (k != innermost) {
-                    mediaStack[childMedia + childCount] = mediaStack[parentMedia + k];
-                    childCount++;
-                }
+                if (k != removeAt) innermost = k;
             }
-            etaT = mediumEta(childMedia, childCount);
+            etaT = innermost == r.mediaCount ? frame.background.w : etaOfSphere(media[innermost]);
         }
         // Snell's law, SPEC §4.5.
         float eta = etaI / etaT;
@@ -370,36 +381,46 @@ void traceOneRay(uint pixel, inout PixelState state, float saturation) {
             // one ray carries both weights.
             reflectedWeight += transmittedWeight;
         } else if (worthTracing(transmittedWeight)) {
-            if (COUNT_RAYS) countedRays[SNELL_COUNTER_REFRACTED]++;
-            if (HAS_REFLECTION && worthTracing(reflectedWeight)) {
-                // The reflected child reuses the parent's slot and media; the
-                // refracted one goes above it, its media already in place.
-                if (COUNT_RAYS) countedRays[SNELL_COUNTER_REFLECTED]++;
-                pushRay(pixel, state, x, d - 2.0 * dot(d, n) * n, reflectedWeight, r.depth + 1u, hitSphere,
-                        !fromOutside, r.mediaCount);
-                pushRay(pixel, state, x, normalize(eta * d + (eta * c - sqrt(k)) * n), transmittedWeight,
-                        r.depth + 1u, hitSphere, fromOutside, childCount);
-                return;
-            }
-            pushRay(pixel, state, x, normalize(eta * d + (eta * c - sqrt(k)) * n), transmittedWeight,
-                    r.depth + 1u, hitSphere, fromOutside, childCount);
-            // Its media were built one slot up: move them into its slot.
-            uint top = pixel * uint(RAY_STACK) + state.pending - 1u;
-            if (top != slot + 1u) {
-                tick();
-                for (uint j = 0u; j < childCount; ++j) {
-                    tick();
-                    mediaStack[top * uint(MAX_MEDIA) + j] = mediaStack[childMedia + j];
-                }
-            }
-            return;
+            refracts = true;
+            refracted = normalize(eta * d + (eta * c - sqrt(k)) * n);
         }
     }
-    if ((HAS_REFLECTION || HAS_REFRACTION) && worthTracing(reflectedWeight)) {
-        // Reflected rays keep the parent's medium stack, already in this slot.
+    bool reflects = (HAS_REFLECTION || HAS_REFRACTION) && worthTracing(reflectedWeight);
+    Ray reflectedRay = Ray(x, d - 2.0 * dot(d, n) * n, reflectedWeight, r.depth + 1u, hitSphere, !fromOutside,
+                           r.mediaCount);
+    if (reflects) {
         if (COUNT_RAYS) countedRays[SNELL_COUNTER_REFLECTED]++;
-        pushRay(pixel, state, x, d - 2.0 * dot(d, n) * n, reflectedWeight, r.depth + 1u, hitSphere,
-                !fromOutside, r.mediaCount);
+        if (!refracts) {
+            r = reflectedRay;
+            hasRay = true;
+            return;
+        }
+        pushRay(pixel, state, reflectedRay);  // with the parent's media, still current
+    }
+    if (refracts) {
+        if (COUNT_RAYS) countedRays[SNELL_COUNTER_REFRACTED]++;
+        uint count = r.mediaCount;
+        if (fromOutside) {
+            if (count == uint(MAX_MEDIA)) {  // deeper than the scene can nest: forget the outermost
+                tick();
+                for (uint k = 0u; k + 1u < count; ++k) {
+                    tick();
+                    media[k] = media[k + 1u];
+                }
+                count--;
+            }
+            media[count] = hitSphere;
+            count++;
+        } else if (removeAt < count) {
+            tick();
+            for (uint k = removeAt; k + 1u < count; ++k) {
+                tick();
+                media[k] = media[k + 1u];
+            }
+            count--;
+        }
+        r = Ray(x, refracted, transmittedWeight, r.depth + 1u, hitSphere, fromOutside, count);
+        hasRay = true;
     }
 }
 
@@ -421,6 +442,8 @@ void main() {
     float saturation = AMPLIFYING ? float(samples) : NO_HIT;
     uvec2 imagePixel = local + uvec2(tile.originX, tile.originY);
 
+    Ray ray;
+    bool hasRay = false;
     // Every lane stays in this loop until the subgroup leaves it together, so
     // the subgroup operations below see all lanes.
     while (true) {
@@ -431,7 +454,11 @@ void main() {
         }
         tick();
         if (!done) {
-            if (state.pending == 0u) {
+            if (!hasRay && state.pending > 0u) {
+                ray = popRay(pixel, state);
+                hasRay = true;
+            }
+            if (!hasRay) {
                 if (state.started == samples) {
                     done = true;
                 } else {
@@ -439,19 +466,19 @@ void main() {
                     uvec2 ab = uvec2(state.started % s, state.started / s);
                     vec2 p = vec2(imagePixel) + (vec2(ab) + 0.5) / float(s);
                     vec3 dir = normalize(frame.cornerDir.xyz + p.x * frame.pixelRight.xyz + p.y * frame.pixelDown.xyz);
-                    uint slot = pixel * uint(RAY_STACK);
-                    rayStack[slot] = PendingRay(vec4(0.0), vec4(dir, 0.0), vec4(1.0), 0u, NONE, 0u, 0u);
-                    state.pending = 1u;
+                    ray = Ray(vec3(0.0), dir, vec3(1.0), 0u, NONE, false, 0u);
+                    hasRay = true;
                     state.started++;
                     if (COUNT_RAYS) countedRays[SNELL_COUNTER_PRIMARY]++;
                 }
-            } else {
-                traceOneRay(pixel, state, saturation);
             }
+            if (hasRay) traceRay(pixel, state, ray, hasRay, saturation);
         }
     }
 
     if (inTile) {
+        // Suspending: the ray in hand waits on the stack for the next dispatch.
+        if (hasRay) pushRay(pixel, state, ray);
         state.done = done ? 1u : 0u;
         pixelStates[pixel] = state;
         if (done) imageStore(outputImage, ivec2(local), vec4(state.sum.rgb / float(samples), 1.0));
@@ -462,6 +489,8 @@ void main() {
             if (countedRays[k] != 0u) atomicAdd(counters[k], countedRays[k]);
     }
     // Past the driver's limit some loop may have been cut short: say so.
-    if (LOOP_BUDGET != 0u && subgroupElect() && subgroupAdd(loopTicks) >= SNELL_DRIVER_LOOP_LIMIT)
-        atomicAdd(counters[SNELL_COUNTER_LOOP_LIMIT], 1u);
+    if (LOOP_BUDGET != 0u) {
+        uint spent = subgroupAdd(loopTicks);  // all lanes take part
+        if (subgroupElect() && spent >= SNELL_DRIVER_LOOP_LIMIT) atomicAdd(counters[SNELL_COUNTER_LOOP_LIMIT], 1u);
+    }
 }

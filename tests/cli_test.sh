@@ -37,6 +37,10 @@ grep -q "^$work/bad.scn:3:9: error: " "$work/err" && ok || bad "error format: $(
 "$SNELL" render "$SCENES/basic.scn" -o "$work/no/such/dir/x.png" 2>"$work/err"; status=$?
 [ $status -eq 1 ] && grep -q "does not exist" "$work/err" && ok || bad "missing output dir ($status)"
 
+# No Vulkan driver at all: status 1, a message naming the package, no file.
+VK_ICD_FILENAMES=/nonexistent/icd.json "$SNELL" render "$SCENES/basic.scn" -o "$work/nodev.png" 2>"$work/err"; status=$?
+[ $status -eq 1 ] && grep -q "mesa-vulkan-drivers" "$work/err" && [ ! -e "$work/nodev.png" ] && ok || bad "no Vulkan driver ($status): $(cat "$work/err")"
+
 # A good render in every format, with --stats as the last line of stdout.
 for ext in png ppm pfm; do
   "$SNELL" render "$SCENES/basic.scn" --size 32 -o "$work/basic.$ext" --stats >"$work/stats" 2>"$work/err"; status=$?

@@ -3,6 +3,7 @@
 // scene files. Runs on lavapipe in CI and is never skipped: no Vulkan device is
 // a failure. On failure the GPU image, the reference and a difference image are
 // written to build/test-artifacts/ and named in the message.
+#include <chrono>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -103,8 +104,10 @@ TEST_P(GpuAgreement, MatchesCpuReference) {
     snell::RenderRequest reference = request;
     reference.trace = snell::kReferenceSettings;
     if (c.referenceDepth) reference.trace.maxDepth = c.referenceDepth;
+    const auto cpuStart = std::chrono::steady_clock::now();
     const snell::CpuRenderer cpu(scene);
     const snell::Image exact = cpu.render(reference);
+    const double cpuMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - cpuStart).count();
 
     const snell::ImageMetrics m = snell::compareImages(gpu.image, exact, kBadThreshold);
     // Leave out of the bad count the pixels whose exact value is ill-conditioned.
@@ -150,7 +153,7 @@ TEST_P(GpuAgreement, MatchesCpuReference) {
     }
     const double badFraction = double(m.badPixels - illConditioned - unconverged) / double(m.pixels);
     std::cout << "[ metrics ] " << fs::path(c.path).filename().string() << " " << m.json()
-              << " ill_conditioned_left_out=" << illConditioned << " unconverged_left_out=" << unconverged << " gpu_ms=" << gpu.renderMs << "\n";
+              << " ill_conditioned_left_out=" << illConditioned << " unconverged_left_out=" << unconverged << " gpu_ms=" << gpu.renderMs << " cpu_ms=" << cpuMs << "\n";
 
     const bool pass = m.nonFinite == 0 && m.meanAbsError <= kMaxMeanError && badFraction <= kMaxBadFraction;
     std::string artifacts;

@@ -315,6 +315,24 @@ GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool count
             }
         };
 
+        // An empty dispatch first: llvmpipe compiles a shader at its first
+        // dispatch, and that belongs to pipeline creation, not to the render.
+        {
+            const auto warmStart = Clock::now();
+            const gpu::TileParams empty{0, 0, 0, 0};
+            std::memset(p.counters.mapped, 0, SNELL_COUNTER_COUNT * sizeof(std::uint32_t));
+            submit([&](VkCommandBuffer cmd) {
+                imageBarrier(cmd, p.image.image, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL, 0,
+                             VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT,
+                             VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
+                vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.pipeline);
+                vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.layout, 0, 1, &p.set, 0, nullptr);
+                vkCmdPushConstants(cmd, p.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof empty, &empty);
+                vkCmdDispatch(cmd, 1, 1, 1);
+            }, false);
+            result.pipelineMs += msSince(warmStart);
+        }
+
         const int tilesX = (request.width + tileW - 1) / tileW;
         const int tilesY = (request.height + tileH - 1) / tileH;
         const int tileCount = tilesX * tilesY;
@@ -338,11 +356,11 @@ GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool count
                             memoryBarrier(cmd, VK_ACCESS_TRANSFER_WRITE_BIT,
                                           VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT,
                                           VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
-                            imageBarrier(cmd, p.image.image,
-                                         imageUsed ? VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL : VK_IMAGE_LAYOUT_UNDEFINED,
-                                         VK_IMAGE_LAYOUT_GENERAL, imageUsed ? VK_ACCESS_TRANSFER_READ_BIT : 0,
-                                         VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
-                                         VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
+                            if (imageUsed)
+                                imageBarrier(cmd, p.image.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                                             VK_IMAGE_LAYOUT_GENERAL, VK_ACCESS_TRANSFER_READ_BIT,
+                                             VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
+                                             VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
                         } else {
                             // The previous dispatch's pixel states and stacks.
                             memoryBarrier(cmd, VK_ACCESS_SHADER_WRITE_BIT,
@@ -356,7 +374,6 @@ GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool count
                         memoryBarrier(cmd, VK_ACCESS_SHADER_WRITE_BIT, VK_ACCESS_HOST_READ_BIT,
                                       VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT);
                     }, true);
-                    imageUsed = true;
                     ++result.dispatches;
                     if (counters[SNELL_COUNTER_LOOP_LIMIT] != 0)
                         throw vk::VulkanError("a single ray needed more loop iterations than lavapipe allows in one "
@@ -400,6 +417,7 @@ GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool count
                     }
                 }
                 result.readbackMs += msSince(readStart);
+                imageUsed = true;
                 ++result.tiles;
             }
         }
