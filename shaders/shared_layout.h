@@ -71,11 +71,16 @@ using uint = std::uint32_t;
 // Hard upper bound of the shader's per-ray medium stack.
 #define SNELL_MAX_MEDIA_LIMIT 16
 
-// One primitive. Coordinates are camera-relative (world minus eye), prepared
-// in double on the host. For a true sphere centreRadius is (centre, radius);
-// for an ellipsoid it is a bounding sphere and `ellipsoid` indexes Ellipsoid.
+// One primitive. Coordinates are relative to the render's origin (a point
+// just in front of the nearest geometry along the view, prepared in double on
+// the host: host/gpu/GpuScene.h). A true sphere is stored by its anchor: the
+// surface point P0 nearest the origin, the outward normal n0 there and the
+// radius, so |f|² − r² = |o − P0|² + 2r n0·(o − P0) has no cancellation near
+// the surface even for a floor of radius 10⁶. For an ellipsoid, anchorRadius
+// is its centre and a bounding radius and `ellipsoid` indexes Ellipsoid.
 struct Sphere {
-    vec4 centreRadius;
+    vec4 anchorRadius;  // xyz: P0, w: radius
+    vec4 normal;        // xyz: n0 (unit), w unused
     uint material;
     uint ellipsoid;
     uint pad0;
@@ -138,8 +143,10 @@ struct PendingRay {
 // Per-render parameters (uniform buffer). The primary ray through the image
 // point with pixel coordinates (x, y) has direction
 //   normalize(cornerDir + x * pixelRight + y * pixelDown)       (SPEC §3)
-// from the camera origin, which is the coordinate origin (camera-relative).
+// from the eye; it starts at distance primaryStart.w along that direction,
+// before any geometry, where coordinates are small.
 struct FrameParams {
+    vec4 primaryStart;  // xyz: eye minus origin; w: distance D along each primary ray where it starts
     vec4 cornerDir;     // xyz: image-plane corner (pixel coords 0,0) minus eye
     vec4 pixelRight;    // xyz: one pixel step along a row
     vec4 pixelDown;     // xyz: one pixel step down a column

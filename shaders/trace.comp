@@ -111,20 +111,25 @@ float intersectSphere(uint index, vec3 origin, vec3 dir, uint fromSphere, uint s
             return b < 0.0 ? 0.0 : NO_HIT;
         return rootsToHit(b, a, dot(o, o) - 1.0, discriminant);
     }
-    vec3 f = origin - s.centreRadius.xyz;
-    float r = s.centreRadius.w;
-    float b = dot(f, dir);
+    // True sphere, anchored (shared_layout.h): g = o − P0, f = o − centre = g + r n0.
+    vec3 g = origin - s.anchorRadius.xyz;
+    float r = s.anchorRadius.w;
+    vec3 n0 = s.normal.xyz;
+    float b = dot(g, dir) + r * dot(n0, dir);
     if (mode == ENTERING) {
         float chord = -2.0 * b;
         return chord > 0.0 ? chord : NO_HIT;
     }
+    vec3 f = g + r * n0;
     vec3 perpendicular = f - b * dir;
     float discriminant = r * r - dot(perpendicular, perpendicular);
     if (discriminant < 0.0) return NO_HIT;
-    float lengthF = length(f);
-    if (startsOnSurface(lengthF - r, ROUNDING * (length(origin) + length(s.centreRadius.xyz) + r)))
+    // |f|² − r² without cancellation near the surface.
+    float c = dot(g, g) + 2.0 * r * dot(n0, g);
+    float lengthG = length(g);
+    if (startsOnSurface(c / (length(f) + r), ROUNDING * (length(origin) + length(s.anchorRadius.xyz) + lengthG)))
         return b < 0.0 ? 0.0 : NO_HIT;
-    return rootsToHit(b, 1.0, dot(f, f) - r * r, discriminant);
+    return rootsToHit(b, 1.0, c, discriminant);
 }
 
 // Slab test against a node's box (stored rounded outwards), within [0, tMax].
@@ -333,7 +338,7 @@ void traceRay(uint pixel, inout PixelState state, inout Ray r, out bool hasRay, 
         vec3 p = (objectFromWorld * vec4(o, 1.0)).xyz + t * (mat3(objectFromWorld) * d);
         outward = normalize(transpose(mat3(objectFromWorld)) * p);
     } else {
-        outward = normalize(o - s.centreRadius.xyz + t * d);
+        outward = normalize(o - s.anchorRadius.xyz + t * d + s.anchorRadius.w * s.normal.xyz);
     }
     bool fromOutside = dot(d, outward) < 0.0;
     vec3 n = fromOutside ? outward : -outward;
@@ -466,7 +471,9 @@ void main() {
                     uvec2 ab = uvec2(state.started % s, state.started / s);
                     vec2 p = vec2(imagePixel) + (vec2(ab) + 0.5) / float(s);
                     vec3 dir = normalize(frame.cornerDir.xyz + p.x * frame.pixelRight.xyz + p.y * frame.pixelDown.xyz);
-                    ray = Ray(vec3(0.0), dir, vec3(1.0), 0u, NONE, false, 0u);
+                    // It starts at distance D along its way, before any geometry.
+                    vec3 start = frame.primaryStart.xyz + frame.primaryStart.w * dir;
+                    ray = Ray(start, dir, vec3(1.0), 0u, NONE, false, 0u);
                     hasRay = true;
                     state.started++;
                     if (COUNT_RAYS) countedRays[SNELL_COUNTER_PRIMARY]++;

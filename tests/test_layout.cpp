@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <set>
 #include <vector>
@@ -15,12 +16,20 @@ namespace {
 namespace gpu = snell::gpu;
 
 TEST(Layout, Sphere) {
-    EXPECT_EQ(sizeof(gpu::Sphere), 32u);
-    EXPECT_EQ(offsetof(gpu::Sphere, centreRadius), 0u);
-    EXPECT_EQ(offsetof(gpu::Sphere, material), 16u);
-    EXPECT_EQ(offsetof(gpu::Sphere, ellipsoid), 20u);
-    EXPECT_EQ(offsetof(gpu::Sphere, pad0), 24u);
-    EXPECT_EQ(offsetof(gpu::Sphere, pad1), 28u);
+    EXPECT_EQ(sizeof(gpu::Sphere), 48u);
+    EXPECT_EQ(offsetof(gpu::Sphere, anchorRadius), 0u);
+    EXPECT_EQ(offsetof(gpu::Sphere, normal), 16u);
+    EXPECT_EQ(offsetof(gpu::Sphere, material), 32u);
+    EXPECT_EQ(offsetof(gpu::Sphere, ellipsoid), 36u);
+    EXPECT_EQ(offsetof(gpu::Sphere, pad0), 40u);
+    EXPECT_EQ(offsetof(gpu::Sphere, pad1), 44u);
+}
+
+// A GPU sphere's centre: anchor − r·n0 for a true sphere, the stored centre
+// of an ellipsoid.
+glm::vec3 centreOf(const gpu::Sphere& s) {
+    if (s.ellipsoid != SNELL_NOT_ELLIPSOID) return glm::vec3(s.anchorRadius);
+    return glm::vec3(s.anchorRadius) - s.anchorRadius.w * glm::vec3(s.normal);
 }
 
 TEST(Layout, Ellipsoid) {
@@ -53,20 +62,21 @@ TEST(Layout, BvhNode) {
 }
 
 TEST(Layout, FrameParams) {
-    EXPECT_EQ(sizeof(gpu::FrameParams), 112u);
-    EXPECT_EQ(offsetof(gpu::FrameParams, cornerDir), 0u);
-    EXPECT_EQ(offsetof(gpu::FrameParams, pixelRight), 16u);
-    EXPECT_EQ(offsetof(gpu::FrameParams, pixelDown), 32u);
-    EXPECT_EQ(offsetof(gpu::FrameParams, background), 48u);
-    EXPECT_EQ(offsetof(gpu::FrameParams, ambient), 64u);
-    EXPECT_EQ(offsetof(gpu::FrameParams, imageWidth), 80u);
-    EXPECT_EQ(offsetof(gpu::FrameParams, imageHeight), 84u);
-    EXPECT_EQ(offsetof(gpu::FrameParams, supersample), 88u);
-    EXPECT_EQ(offsetof(gpu::FrameParams, maxDepth), 92u);
-    EXPECT_EQ(offsetof(gpu::FrameParams, sphereCount), 96u);
-    EXPECT_EQ(offsetof(gpu::FrameParams, lightCount), 100u);
-    EXPECT_EQ(offsetof(gpu::FrameParams, bvhNodeCount), 104u);
-    EXPECT_EQ(offsetof(gpu::FrameParams, pad0), 108u);
+    EXPECT_EQ(sizeof(gpu::FrameParams), 128u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, primaryStart), 0u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, cornerDir), 16u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, pixelRight), 32u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, pixelDown), 48u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, background), 64u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, ambient), 80u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, imageWidth), 96u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, imageHeight), 100u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, supersample), 104u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, maxDepth), 108u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, sphereCount), 112u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, lightCount), 116u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, bvhNodeCount), 120u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, pad0), 124u);
 }
 
 TEST(Layout, TileParams) {
@@ -100,7 +110,7 @@ void expectVec(const glm::vec4& v, float x, float y, float z, float w) {
     EXPECT_FLOAT_EQ(v.w, w);
 }
 
-TEST(GpuScene, SmallSceneIsCameraRelativeAndClassified) {
+TEST(GpuScene, SmallSceneIsOriginRelativeAndClassified) {
     const snell::Scene s = parse("view 10 1\nmove 1 2 3\ngroup\nmaterial 0.1 0.2 0.3 0.4 0.5 0.6 7\n"
                                  "refraction 0.3 0.3 0.3 1.5\nscale 2 2 2\nsphere\ngroupend\n"
                                  "scale 1 2 1\nsphere\nlight 0.7 0.8 0.9 4 5 6\n");
@@ -110,24 +120,36 @@ TEST(GpuScene, SmallSceneIsCameraRelativeAndClassified) {
     ASSERT_EQ(g.spheres.size(), 2u);
     EXPECT_TRUE(g.nodes.empty());  // 2 spheres: no BVH, order kept
 
-    // True sphere: centre (1,2,3) minus eye (0,0,1), radius 2.
-    expectVec(g.spheres[0].centreRadius, 1, 2, 2, 2);
+    // The origin: where primary rays start, just before the nearest bounding
+    // sphere (the ellipsoid's: centre distance 3, bounding radius √6).
+    const double nearest = 3.0 - std::sqrt(6.0);
+    EXPECT_LT(g.primaryStart, nearest);
+    EXPECT_GT(g.primaryStart, nearest - 1e-3 * std::sqrt(6.0) - 1e-6);  // margin: a sliver of its size
+    EXPECT_EQ(g.origin, g.eye + g.primaryStart * camera.forward);
+    const glm::vec3 o(g.origin);
+    auto rel = [&](double x, double y, double z) { return glm::vec3(x, y, z) - o; };
+
+    // True sphere: centre (1,2,3), radius 2, anchored at its point nearest the
+    // origin with the outward normal there.
     EXPECT_EQ(g.spheres[0].ellipsoid, SNELL_NOT_ELLIPSOID);
-    // Ellipsoid: its bounding sphere's centre is camera-relative too.
-    EXPECT_NE(g.spheres[1].ellipsoid, SNELL_NOT_ELLIPSOID);
+    EXPECT_FLOAT_EQ(g.spheres[0].anchorRadius.w, 2.0f);
+    const glm::vec3 c0 = rel(1, 2, 3);
+    const glm::vec3 n0 = -glm::normalize(c0);
+    EXPECT_NEAR(glm::length(glm::vec3(g.spheres[0].normal) - n0), 0.0f, 1e-6f);
+    EXPECT_NEAR(glm::length(glm::vec3(g.spheres[0].anchorRadius) - (c0 + 2.0f * n0)), 0.0f, 1e-6f);
+    EXPECT_NEAR(glm::length(centreOf(g.spheres[0]) - c0), 0.0f, 1e-5f);
+    // Ellipsoid: centre and bounding radius, and its matrix.
     ASSERT_EQ(g.ellipsoids.size(), 1u);
     EXPECT_EQ(g.spheres[1].ellipsoid, 0u);
-    EXPECT_FLOAT_EQ(g.spheres[1].centreRadius.x, 1);
-    EXPECT_FLOAT_EQ(g.spheres[1].centreRadius.y, 2);
-    EXPECT_FLOAT_EQ(g.spheres[1].centreRadius.z, 2);
-    EXPECT_GE(g.spheres[1].centreRadius.w, 2.0f);
-    // Its matrix maps camera-relative points to object space: the world point
-    // (1, 4, 3) = top of the ellipsoid is (1, 4, 2) relative to the eye.
-    const glm::vec4 top = g.ellipsoids[0].objectFromWorld * glm::vec4(1, 4, 2, 1);
+    EXPECT_NEAR(glm::length(centreOf(g.spheres[1]) - rel(1, 2, 3)), 0.0f, 1e-6f);
+    EXPECT_GE(g.spheres[1].anchorRadius.w, 2.0f);
+    // Its matrix maps origin-relative points to object space: the world point
+    // (1, 4, 3) is the top of the ellipsoid.
+    const glm::vec4 top = g.ellipsoids[0].objectFromWorld * glm::vec4(rel(1, 4, 3), 1);
     EXPECT_NEAR(top.x, 0.0f, 1e-6f);
     EXPECT_NEAR(top.y, 1.0f, 1e-6f);
     EXPECT_NEAR(top.z, 0.0f, 1e-6f);
-    const glm::vec4 centre = g.ellipsoids[0].objectFromWorld * glm::vec4(1, 2, 2, 1);
+    const glm::vec4 centre = g.ellipsoids[0].objectFromWorld * glm::vec4(rel(1, 2, 3), 1);
     EXPECT_NEAR(glm::length(glm::vec3(centre)), 0.0f, 1e-6f);
 
     // Materials and lights.
@@ -142,9 +164,7 @@ TEST(GpuScene, SmallSceneIsCameraRelativeAndClassified) {
     EXPECT_EQ(g.refractiveSpheres, 1u);
     EXPECT_FALSE(g.amplifying);
     ASSERT_EQ(g.lights.size(), 1u);
-    EXPECT_FLOAT_EQ(g.lights[0].position.x, 4);
-    EXPECT_FLOAT_EQ(g.lights[0].position.y, 5);
-    EXPECT_FLOAT_EQ(g.lights[0].position.z, 5);  // 6 - 1
+    EXPECT_NEAR(glm::length(glm::vec3(g.lights[0].position) - rel(4, 5, 6)), 0.0f, 1e-6f);
     EXPECT_FLOAT_EQ(g.lights[0].colour.r, 0.7f);
     EXPECT_FLOAT_EQ(g.lights[0].colour.b, 0.9f);
 
@@ -158,6 +178,9 @@ TEST(GpuScene, SmallSceneIsCameraRelativeAndClassified) {
     EXPECT_FLOAT_EQ(f.cornerDir.z, -1.0f);
     EXPECT_FLOAT_EQ(f.pixelRight.x, 0.2f);
     EXPECT_FLOAT_EQ(f.pixelDown.y, -0.2f);
+    // Primary rays start at the origin's distance, from the eye (relative to it).
+    EXPECT_FLOAT_EQ(f.primaryStart.w, static_cast<float>(g.primaryStart));
+    EXPECT_NEAR(glm::length(glm::vec3(f.primaryStart) - rel(0, 0, 1)), 0.0f, 1e-6f);
 }
 
 TEST(GpuScene, AmplifyingMaterialFlagged) {
@@ -182,7 +205,7 @@ TEST(GpuScene, NoBvhAtTheThreshold) {
     EXPECT_TRUE(g.nodes.empty());
     ASSERT_EQ(g.spheres.size(), gpu::kBvhThreshold);
     for (std::size_t i = 0; i < g.spheres.size(); ++i)
-        EXPECT_FLOAT_EQ(g.spheres[i].centreRadius.x, 3.0f * (i + 1));
+        EXPECT_NEAR(centreOf(g.spheres[i]).x, 3.0f * (i + 1), 1e-5f);
 }
 
 TEST(GpuScene, BvhAboveTheThresholdHoldsEverySphereOnce) {
@@ -198,16 +221,16 @@ TEST(GpuScene, BvhAboveTheThresholdHoldsEverySphereOnce) {
         std::multiset<int> seen;
         std::set<std::uint32_t> ellipsoidIndices;
         for (const gpu::Sphere& sp : g.spheres) {
-            seen.insert(static_cast<int>(std::lround(sp.centreRadius.x / 3.0f)));
+            seen.insert(static_cast<int>(std::lround(centreOf(sp).x / 3.0f)));
             const bool isEllipsoid = sp.ellipsoid != SNELL_NOT_ELLIPSOID;
-            const int index = static_cast<int>(std::lround(sp.centreRadius.x / 3.0f)) - 1;
-            EXPECT_EQ(isEllipsoid, index % 3 == 2) << "sphere at x = " << sp.centreRadius.x;
+            const int index = static_cast<int>(std::lround(centreOf(sp).x / 3.0f)) - 1;
+            EXPECT_EQ(isEllipsoid, index % 3 == 2) << "sphere at x = " << centreOf(sp).x;
             if (isEllipsoid) {
                 ASSERT_LT(sp.ellipsoid, g.ellipsoids.size());
                 EXPECT_TRUE(ellipsoidIndices.insert(sp.ellipsoid).second);
                 // The ellipsoid's matrix belongs to this sphere: it maps its centre to 0.
                 const glm::vec4 c = g.ellipsoids[sp.ellipsoid].objectFromWorld *
-                                    glm::vec4(glm::vec3(sp.centreRadius), 1.0f);
+                                    glm::vec4(centreOf(sp), 1.0f);
                 EXPECT_NEAR(glm::length(glm::vec3(c)), 0.0f, 1e-4f);
             }
         }
@@ -232,7 +255,7 @@ TEST(GpuScene, BvhAboveTheThresholdHoldsEverySphereOnce) {
             for (std::uint32_t k = node.first; k < node.first + node.count; ++k) {
                 ASSERT_LT(k, n);
                 ++covered[k];
-                const glm::vec4 cr = g.spheres[k].centreRadius;
+                const glm::vec4 cr(centreOf(g.spheres[k]), g.spheres[k].anchorRadius.w);
                 // A true sphere's radius is exact; an ellipsoid's only bounds
                 // it, so only its centre is checked.
                 const float r = g.spheres[k].ellipsoid == SNELL_NOT_ELLIPSOID ? cr.w : 0.0f;

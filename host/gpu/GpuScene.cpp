@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <limits>
 
 #include "bvh/Bvh.h"
 
@@ -28,11 +29,32 @@ void outwardBox(const snell::Aabb& box, const snell::dvec3& eye, vec4& lower, ve
 
 }  // namespace
 
+double primaryStartDistance(const snell::Scene& scene, const snell::dvec3& eye) {
+    // The nearest any sphere's bounding sphere comes to the eye, less a margin
+    // for the float rounding of the start point along the ray (≈ 2⁻²⁴ D) and a
+    // sliver of the nearest sphere's size.
+    double nearest = std::numeric_limits<double>::infinity();
+    double nearestRadius = 0.0;
+    for (const snell::Sphere& s : scene.spheres) {
+        const double d = glm::length(s.centre - eye) - s.radius;
+        if (d < nearest) {
+            nearest = d;
+            nearestRadius = s.radius;
+        }
+    }
+    if (!(nearest > 0.0) || !std::isfinite(nearest)) return 0.0;
+    const double margin = 16.0 * 0x1p-24 * nearest + 1e-3 * nearestRadius;
+    return std::max(0.0, nearest - margin);
+}
+
 GpuScene buildGpuScene(const snell::Scene& scene, const snell::Camera& camera) {
     GpuScene out;
     out.eye = camera.eye;
-    const snell::dvec3 eye = camera.eye;
-    // Camera-relative: objectFromCamera = objectFromWorld · T(eye), in double.
+    // The GPU's coordinate origin: where the central primary ray starts.
+    out.primaryStart = primaryStartDistance(scene, camera.eye);
+    out.origin = camera.eye + out.primaryStart * camera.forward;
+    const snell::dvec3 eye = out.origin;  // everything below is relative to it
+    // objectFromOrigin = objectFromWorld · T(origin), in double.
     snell::dmat4 worldFromCamera(1.0);
     worldFromCamera[3] = glm::dvec4(eye, 1.0);
 
@@ -85,9 +107,16 @@ GpuScene buildGpuScene(const snell::Scene& scene, const snell::Camera& camera) {
         const snell::Sphere& s = scene.spheres[index];
         Sphere g{};
         g.material = s.material;
-        g.centreRadius = toVec4(s.centre - eye, s.radius);
         g.ellipsoid = SNELL_NOT_ELLIPSOID;
-        if (!s.isTrueSphere) {
+        const snell::dvec3 centre = s.centre - eye;
+        if (s.isTrueSphere) {
+            // The anchor: the surface point nearest the origin, and its normal.
+            const double distance = glm::length(centre);
+            const snell::dvec3 n0 = distance > 0.0 ? -centre / distance : snell::dvec3(0.0, 0.0, 1.0);
+            g.anchorRadius = toVec4(centre + s.radius * n0, s.radius);
+            g.normal = toVec4(n0, 0.0);
+        } else {
+            g.anchorRadius = toVec4(centre, s.radius);
             g.ellipsoid = static_cast<uint>(out.ellipsoids.size());
             Ellipsoid e;
             e.objectFromWorld = mat4(s.objectFromWorld * worldFromCamera);
@@ -108,6 +137,7 @@ GpuScene buildGpuScene(const snell::Scene& scene, const snell::Camera& camera) {
 FrameParams makeFrameParams(const snell::Scene& scene, const GpuScene& gpuScene, const snell::Camera& camera,
                             int width, int height, int supersample, int maxDepth, double minWeight) {
     FrameParams f{};
+    f.primaryStart = toVec4(camera.eye - gpuScene.origin, gpuScene.primaryStart);
     f.cornerDir = toVec4(camera.cornerDir, 0.0);
     f.pixelRight = toVec4(camera.pixelRight, 0.0);
     f.pixelDown = toVec4(camera.pixelDown, 0.0);

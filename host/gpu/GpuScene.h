@@ -1,7 +1,9 @@
 // The scene's GPU layout: what the compute shader reads, prepared in double on
-// the host. Camera-relative coordinates (world minus eye) keep precision where
-// the rays start; true spheres are centre + radius, only ellipsoids carry
-// matrices; spheres are in BVH leaf order when a BVH is used. No Vulkan here.
+// the host. Coordinates are relative to an origin just in front of the nearest
+// geometry along the view (primary rays start there), so a scene far from the
+// eye, or a tiny one, keeps float precision at its own scale; true spheres are
+// anchored surface points (shared_layout.h), only ellipsoids carry matrices;
+// spheres are in BVH leaf order when a BVH is used. No Vulkan here.
 #pragma once
 
 #include <cstddef>
@@ -12,14 +14,15 @@
 
 namespace snell::gpu {
 
-static_assert(sizeof(Sphere) == 32 && offsetof(Sphere, material) == 16 && offsetof(Sphere, ellipsoid) == 20);
+static_assert(sizeof(Sphere) == 48 && offsetof(Sphere, normal) == 16 && offsetof(Sphere, material) == 32 &&
+              offsetof(Sphere, ellipsoid) == 36);
 static_assert(sizeof(Ellipsoid) == 64);
 static_assert(sizeof(Material) == 48 && offsetof(Material, kt) == 32);
 static_assert(sizeof(Light) == 32 && offsetof(Light, colour) == 16);
 static_assert(sizeof(BvhNode) == 48 && offsetof(BvhNode, first) == 32 && offsetof(BvhNode, count) == 36 &&
               offsetof(BvhNode, skip) == 40);
-static_assert(sizeof(FrameParams) == 112 && offsetof(FrameParams, imageWidth) == 80 &&
-              offsetof(FrameParams, bvhNodeCount) == 104);
+static_assert(sizeof(FrameParams) == 128 && offsetof(FrameParams, cornerDir) == 16 &&
+              offsetof(FrameParams, imageWidth) == 96 && offsetof(FrameParams, bvhNodeCount) == 120);
 static_assert(sizeof(TileParams) == 16);
 static_assert(sizeof(PixelState) == 32 && offsetof(PixelState, started) == 16);
 static_assert(sizeof(PendingRay) == 64 && offsetof(PendingRay, depth) == 48 && offsetof(PendingRay, mediaCount) == 60);
@@ -35,12 +38,17 @@ struct GpuScene {
     std::vector<BvhNode> nodes;  // empty when no BVH is used
     std::size_t refractiveSpheres = 0;
     bool amplifying = false;
-    snell::dvec3 eye{0.0};       // the world point that is the origin on the GPU
+    snell::dvec3 eye{0.0};       // the camera's eye
+    snell::dvec3 origin{0.0};    // the world point that is the origin on the GPU
+    double primaryStart = 0.0;   // distance from the eye at which primary rays start
     int bvhDepth = 0;
     double bvhBuildMs = 0.0;
 };
 
 GpuScene buildGpuScene(const snell::Scene& scene, const snell::Camera& camera);
+
+// How far primary rays from `eye` can go before they could meet any sphere.
+double primaryStartDistance(const snell::Scene& scene, const snell::dvec3& eye);
 
 // The frame parameters of one render (camera relative to camera.eye).
 FrameParams makeFrameParams(const snell::Scene& scene, const GpuScene& gpuScene, const snell::Camera& camera,

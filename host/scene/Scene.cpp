@@ -31,6 +31,7 @@ Camera Camera::fromSpec(int imageSize, double halfWidth) {
     // SPEC §3: P(x, y) = (-d + x*2d/n, d - y*2d/n, 0), eye E = (0, 0, 1).
     Camera c;
     c.eye = dvec3(0.0, 0.0, 1.0);
+    c.forward = dvec3(0.0, 0.0, -1.0);
     c.cornerDir = dvec3(-halfWidth, halfWidth, -1.0);
     const double step = 2.0 * halfWidth / imageSize;
     c.pixelRight = dvec3(step, 0.0, 0.0);

@@ -88,6 +88,7 @@ struct Scene {
 // `eye` towards cornerDir + x * pixelRight + y * pixelDown, (x, y) in pixels.
 struct Camera {
     dvec3 eye{0.0, 0.0, 1.0};
+    dvec3 forward{0.0, 0.0, -1.0};  // unit direction through the image centre
     dvec3 cornerDir{0.0};
     dvec3 pixelRight{0.0};
     dvec3 pixelDown{0.0};
