@@ -34,6 +34,9 @@ struct Case {
     std::string path;
     int size = 128;
     int referenceDepth = 0;  // 0: kReferenceSettings
+    // Issue 4's speckle rule holds for snell's own scenes; the course files'
+    // speckles (chaotic multi-bounce pixels in becker-1n) are reported only.
+    bool noSpeckles = true;
 };
 
 void PrintTo(const Case& c, std::ostream* os) { *os << c.path; }
@@ -54,6 +57,7 @@ std::vector<Case> allCases() {
         // its reference stops at depth 20 (measured: depth 20 and 24 differ by
         // at most 3/255, and depth 64 is out of reach).
         if (name == "becker-SphereFlake2") c.referenceDepth = 20;
+        c.noSpeckles = p.find("/course-scenes/") == std::string::npos;
         cases.push_back(c);
     }
     return cases;
@@ -77,6 +81,46 @@ std::string testName(const testing::TestParamInfo<Case>& info) {
     for (char& c : n)
         if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
     return n;
+}
+
+int worstDifference(const snell::Image& a, const snell::Image& b, int x, int y) {
+    int worst = 0;
+    for (int k = 0; k < 3; ++k)
+        worst = std::max(worst, std::abs(int(snell::toByte(a.pixel(x, y)[k])) - int(snell::toByte(b.pixel(x, y)[k]))));
+    return worst;
+}
+
+bool movesFrom(const glm::dvec3& v, const snell::Image& exact, int x, int y) {
+    for (int k = 0; k < 3; ++k)
+        if (std::abs(int(snell::toByte(float(v[k]))) - int(snell::toByte(exact.pixel(x, y)[k]))) > kBadThreshold)
+            return true;
+    return false;
+}
+
+// Amplifying scenes (SPEC §4): a pixel whose reference still moves between 3/4
+// of the reference depth and the full depth has not converged; its exact value
+// is out of the reference's reach.
+bool convergedAt(const snell::CpuRenderer& cpu, const snell::RenderRequest& reference, const snell::Image& exact,
+                 int x, int y) {
+    snell::RenderRequest shallower = reference;
+    shallower.trace.maxDepth = reference.trace.maxDepth * 3 / 4;
+    snell::RayCounts ignored;
+    return !movesFrom(cpu.renderPixel(shallower, x, y, ignored), exact, x, y);
+}
+
+// Issue 4's rule: ill-conditioned when the value moves by more than 3/255 as
+// the primary rays move by 1e-4 pixel, tried in eight directions.
+bool illConditionedAt(const snell::CpuRenderer& cpu, const snell::RenderRequest& reference, const snell::Image& exact,
+                      int x, int y) {
+    const double h = std::sqrt(0.5);
+    for (const glm::dvec2 shift : {glm::dvec2(1, 0), glm::dvec2(-1, 0), glm::dvec2(0, 1), glm::dvec2(0, -1),
+                                   glm::dvec2(h, h), glm::dvec2(-h, h), glm::dvec2(h, -h), glm::dvec2(-h, -h)}) {
+        snell::RenderRequest moved = reference;
+        moved.camera.cornerDir += kConditionShift * (shift.x * moved.camera.pixelRight + shift.y * moved.camera.pixelDown);
+        snell::RayCounts ignored;
+        if (movesFrom(cpu.renderPixel(moved, x, y, ignored), exact, x, y)) return true;
+    }
+    return false;
 }
 
 class GpuAgreement : public testing::TestWithParam<Case> {};
@@ -110,52 +154,42 @@ TEST_P(GpuAgreement, MatchesCpuReference) {
     const double cpuMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - cpuStart).count();
 
     const snell::ImageMetrics m = snell::compareImages(gpu.image, exact, kBadThreshold);
-    // Leave out of the bad count the pixels whose exact value is ill-conditioned.
+    // Pixels the reference itself shows to be out of reach are left out of the
+    // bad-pixel and speckle counts, and counted.
+    const bool amplifying = std::any_of(scene.materials.begin(), scene.materials.end(),
+                                        [](const snell::Material& mm) { return mm.amplifies(); });
+    std::vector<char> excluded(std::size_t(c.size) * c.size, 0);
     std::uint64_t illConditioned = 0, unconverged = 0;
     for (int y = 0; y < c.size; ++y) {
         for (int x = 0; x < c.size; ++x) {
-            int worst = 0;
-            for (int k = 0; k < 3; ++k)
-                worst = std::max(worst, std::abs(int(snell::toByte(gpu.image.pixel(x, y)[k])) -
-                                                 int(snell::toByte(exact.pixel(x, y)[k]))));
-            if (worst <= kBadThreshold) continue;
-            // Amplifying scenes (SPEC §4): a pixel whose reference still moves
-            // between depth 48 and the reference depth has not converged, and
-            // its exact value is out of the reference's reach.
-            if (scene.materials.end() != std::find_if(scene.materials.begin(), scene.materials.end(),
-                                                       [](const snell::Material& mm) { return mm.amplifies(); })) {
-                snell::RenderRequest shallower = reference;
-                shallower.trace.maxDepth = reference.trace.maxDepth * 3 / 4;
-                snell::RayCounts ignored;
-                const glm::dvec3 v = cpu.renderPixel(shallower, x, y, ignored);
-                bool moving = false;
-                for (int k = 0; k < 3; ++k)
-                    moving |= std::abs(int(snell::toByte(float(v[k]))) - int(snell::toByte(exact.pixel(x, y)[k]))) > kBadThreshold;
-                if (moving) {
-                    ++unconverged;
-                    continue;
-                }
+            if (worstDifference(gpu.image, exact, x, y) <= kBadThreshold) continue;
+            if (amplifying && !convergedAt(cpu, reference, exact, x, y)) {
+                ++unconverged;
+                excluded[std::size_t(y) * c.size + x] = 1;
+            } else if (illConditionedAt(cpu, reference, exact, x, y)) {
+                ++illConditioned;
+                excluded[std::size_t(y) * c.size + x] = 1;
             }
-            bool unstable = false;
-            // Eight directions: along the axes and the diagonals.
-            const double h = std::sqrt(0.5);
-            for (const auto& shift : {glm::dvec2(1, 0), glm::dvec2(-1, 0), glm::dvec2(0, 1), glm::dvec2(0, -1),
-                                      glm::dvec2(h, h), glm::dvec2(-h, h), glm::dvec2(h, -h), glm::dvec2(-h, -h)}) {
-                snell::RenderRequest moved = reference;
-                moved.camera.cornerDir += kConditionShift * (shift.x * moved.camera.pixelRight + shift.y * moved.camera.pixelDown);
-                snell::RayCounts ignored;
-                const glm::dvec3 v = cpu.renderPixel(moved, x, y, ignored);
-                for (int k = 0; k < 3; ++k)
-                    unstable |= std::abs(int(snell::toByte(float(v[k]))) - int(snell::toByte(exact.pixel(x, y)[k]))) > kBadThreshold;
-            }
-            illConditioned += unstable;
+        }
+    }
+    // Speckles: off by more than 8/255 with all eight neighbours within 2/255.
+    std::uint64_t speckles = 0;
+    for (int y = 1; y + 1 < c.size; ++y) {
+        for (int x = 1; x + 1 < c.size; ++x) {
+            if (excluded[std::size_t(y) * c.size + x] || worstDifference(gpu.image, exact, x, y) <= 8) continue;
+            bool isolated = true;
+            for (int dy = -1; dy <= 1; ++dy)
+                for (int dx = -1; dx <= 1; ++dx)
+                    if ((dx || dy) && worstDifference(gpu.image, exact, x + dx, y + dy) > 2) isolated = false;
+            speckles += isolated;
         }
     }
     const double badFraction = double(m.badPixels - illConditioned - unconverged) / double(m.pixels);
     std::cout << "[ metrics ] " << fs::path(c.path).filename().string() << " " << m.json()
-              << " ill_conditioned_left_out=" << illConditioned << " unconverged_left_out=" << unconverged << " gpu_ms=" << gpu.renderMs << " cpu_ms=" << cpuMs << "\n";
+              << " ill_conditioned_left_out=" << illConditioned << " unconverged_left_out=" << unconverged
+              << " speckles_counted=" << speckles << " gpu_ms=" << gpu.renderMs << " cpu_ms=" << cpuMs << "\n";
 
-    const bool pass = m.nonFinite == 0 && m.meanAbsError <= kMaxMeanError && badFraction <= kMaxBadFraction;
+    const bool pass = m.nonFinite == 0 && (speckles == 0 || !c.noSpeckles) && m.meanAbsError <= kMaxMeanError && badFraction <= kMaxBadFraction;
     std::string artifacts;
     if (!pass) {
         fs::create_directories(SNELL_ARTIFACT_DIR);
@@ -166,6 +200,9 @@ TEST_P(GpuAgreement, MatchesCpuReference) {
         artifacts = "\nimages: " + base + "-gpu.png, " + base + "-reference.png, " + base + "-diff.png";
     }
     EXPECT_EQ(m.nonFinite, 0u) << artifacts;
+    if (c.noSpeckles)
+        EXPECT_EQ(speckles, 0u) << "isolated pixels off by more than 8/255 (left out: " << m.speckles - speckles
+                            << " ill-conditioned or unconverged)" << artifacts;
     EXPECT_LE(m.meanAbsError, kMaxMeanError) << artifacts;
     EXPECT_LE(badFraction, kMaxBadFraction) << "bad pixels " << m.badPixels << ", ill-conditioned left out "
                                             << illConditioned << ", unconverged left out " << unconverged << artifacts;

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <limits>
 #include <stdexcept>
+#include <vector>
 
 namespace snell {
 
@@ -12,10 +13,12 @@ std::string ImageMetrics::json() const {
     char buffer[512];
     std::snprintf(buffer, sizeof buffer,
                   "{\"mean_abs_error\": %.6f, \"rmse\": %.6f, \"psnr\": %s, \"max_error\": %d, "
-                  "\"bad_pixels\": %llu, \"bad_fraction\": %.8f, \"non_finite\": %llu, \"pixels\": %llu}",
+                  "\"bad_pixels\": %llu, \"bad_fraction\": %.8f, \"non_finite\": %llu, \"speckles\": %llu, "
+                  "\"pixels\": %llu}",
                   meanAbsError, rmse, std::isfinite(psnr) ? std::to_string(psnr).c_str() : "null", maxError,
                   static_cast<unsigned long long>(badPixels), badFraction,
-                  static_cast<unsigned long long>(nonFinite), static_cast<unsigned long long>(pixels));
+                  static_cast<unsigned long long>(nonFinite), static_cast<unsigned long long>(speckles),
+                  static_cast<unsigned long long>(pixels));
     return buffer;
 }
 
@@ -26,6 +29,7 @@ ImageMetrics compareImages(const Image& test, const Image& reference, int badThr
                                     std::to_string(reference.width) + "x" + std::to_string(reference.height));
     ImageMetrics m;
     m.pixels = static_cast<std::uint64_t>(test.width) * test.height;
+    std::vector<int> worstOf(m.pixels, 0);
     double sum = 0.0, sumSquares = 0.0;
     for (std::size_t p = 0; p < m.pixels; ++p) {
         int worst = 0;
@@ -37,8 +41,19 @@ ImageMetrics compareImages(const Image& test, const Image& reference, int badThr
             sumSquares += double(diff) * diff;
             worst = std::max(worst, diff);
         }
+        worstOf[p] = worst;
         m.maxError = std::max(m.maxError, worst);
         if (worst > badThreshold) ++m.badPixels;
+    }
+    for (int y = 1; y + 1 < test.height; ++y) {
+        for (int x = 1; x + 1 < test.width; ++x) {
+            if (worstOf[std::size_t(y) * test.width + x] <= 8) continue;
+            bool isolated = true;
+            for (int dy = -1; dy <= 1; ++dy)
+                for (int dx = -1; dx <= 1; ++dx)
+                    if ((dx || dy) && worstOf[std::size_t(y + dy) * test.width + (x + dx)] > 2) isolated = false;
+            m.speckles += isolated;
+        }
     }
     const double n = m.pixels ? 3.0 * m.pixels : 1.0;
     m.meanAbsError = sum / n;

@@ -17,6 +17,9 @@ struct ImageMetrics {
     std::uint64_t badPixels = 0;  // pixels with some channel off by > badThreshold
     double badFraction = 0.0;
     std::uint64_t nonFinite = 0;  // NaN or Inf values in the test image
+    // Isolated errors: off by more than 8/255 while all eight neighbours are
+    // within 2/255 (acne and self-intersection show up as these).
+    std::uint64_t speckles = 0;
     std::uint64_t pixels = 0;
     std::string json() const;
 };
