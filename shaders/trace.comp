@@ -9,6 +9,7 @@
 #extension GL_KHR_shader_subgroup_vote : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
 #include "shared_layout.h"
+#include "intersect.glsl"
 
 layout(local_size_x = SNELL_WORKGROUP_SIZE_X, local_size_y = SNELL_WORKGROUP_SIZE_Y) in;
 
@@ -41,11 +42,6 @@ layout(set = 0, binding = SNELL_BINDING_MEDIA_STACK, std430) buffer MediaStackBl
 layout(push_constant) uniform TileBlock { TileParams tile; };
 
 const uint NONE = 0xffffffffu;
-const float NO_HIT = 3.0e38;
-// How a ray relates to the sphere it starts on (see Intersect.h: StartsOn).
-const uint ELSEWHERE = 0u;
-const uint LEAVING = 1u;
-const uint ENTERING = 2u;
 
 uint countedRays[SNELL_RAY_COUNTER_COUNT];
 
@@ -59,77 +55,16 @@ void tick() {
 }
 
 // ---------------------------------------------------------------------------
-// Intersection: Haines et al. (Ray Tracing Gems ch. 7) roots; exact chord root
-// for a ray entering the sphere it starts on, no hit for one leaving it. A ray
-// that starts within rounding distance of another sphere's surface (a hit
-// point on a touching or overlapping sphere) starts just outside it: it hits
-// it at once if it heads in, and misses it if it heads out. Without that rule
-// the sign of |f|² − r² is noise there and seams of overlapping spheres come
-// out speckled (see host/reference/Intersect.h, the double twin).
-
-const float ROUNDING = 4.0 * 5.96e-8;  // 4 units of float32 rounding (2^-24)
-
-float rootsToHit(float b, float a, float c, float discriminant) {
-    // q-form: q = −(b + sign(b)·√Δ); roots c/q and q/a, no cancellation.
-    float q = -(b + (b >= 0.0 ? sqrt(discriminant) : -sqrt(discriminant)));
-    if (q == 0.0) return NO_HIT;
-    float t0 = c / q;
-    float t1 = q / a;
-    float near = min(t0, t1);
-    float far = max(t0, t1);
-    return near > 0.0 ? near : (far > 0.0 ? far : NO_HIT);
-}
-
-// `distanceToSurface` and `tolerance` in the same units; b < 0: heading in.
-bool startsOnSurface(float distanceToSurface, float tolerance) {
-    return abs(distanceToSurface) <= tolerance;
-}
+// Intersection: the maths is in intersect.glsl (shared with the test kernel);
+// here the sphere is fetched and the ray's relation to it decided.
 
 float intersectSphere(uint index, vec3 origin, vec3 dir, uint fromSphere, uint start) {
     uint mode = index == fromSphere ? start : ELSEWHERE;
     if (mode == LEAVING) return NO_HIT;
     Sphere s = spheres[index];
-    if (HAS_ELLIPSOIDS && s.ellipsoid != SNELL_NOT_ELLIPSOID) {
-        mat4 objectFromWorld = ellipsoids[s.ellipsoid].objectFromWorld;
-        vec3 o = (objectFromWorld * vec4(origin, 1.0)).xyz;
-        vec3 d = mat3(objectFromWorld) * dir;
-        float a = dot(d, d);
-        float b = dot(o, d);
-        if (mode == ENTERING) {
-            float chord = -2.0 * b / a;
-            return chord > 0.0 ? chord : NO_HIT;
-        }
-        vec3 perpendicular = o - (b / a) * d;
-        float discriminant = a * (1.0 - dot(perpendicular, perpendicular));
-        if (discriminant < 0.0) return NO_HIT;
-        float lengthO = length(o);
-        // Rounding of o: of the origin through the matrix, and of the product.
-        mat3 m = mat3(objectFromWorld);
-        float matrixNorm = max(max(abs(m[0].x) + abs(m[1].x) + abs(m[2].x), abs(m[0].y) + abs(m[1].y) + abs(m[2].y)),
-                               abs(m[0].z) + abs(m[1].z) + abs(m[2].z));
-        if (startsOnSurface(lengthO - 1.0, ROUNDING * (lengthO + 1.0 + matrixNorm * length(origin))))
-            return b < 0.0 ? 0.0 : NO_HIT;
-        return rootsToHit(b, a, dot(o, o) - 1.0, discriminant);
-    }
-    // True sphere, anchored (shared_layout.h): g = o − P0, f = o − centre = g + r n0.
-    vec3 g = origin - s.anchorRadius.xyz;
-    float r = s.anchorRadius.w;
-    vec3 n0 = s.normal.xyz;
-    float b = dot(g, dir) + r * dot(n0, dir);
-    if (mode == ENTERING) {
-        float chord = -2.0 * b;
-        return chord > 0.0 ? chord : NO_HIT;
-    }
-    vec3 f = g + r * n0;
-    vec3 perpendicular = f - b * dir;
-    float discriminant = r * r - dot(perpendicular, perpendicular);
-    if (discriminant < 0.0) return NO_HIT;
-    // |f|² − r² without cancellation near the surface.
-    float c = dot(g, g) + 2.0 * r * dot(n0, g);
-    float lengthG = length(g);
-    if (startsOnSurface(c / (length(f) + r), ROUNDING * (length(origin) + length(s.anchorRadius.xyz) + lengthG)))
-        return b < 0.0 ? 0.0 : NO_HIT;
-    return rootsToHit(b, 1.0, c, discriminant);
+    if (HAS_ELLIPSOIDS && s.ellipsoid != SNELL_NOT_ELLIPSOID)
+        return intersectEllipsoid(ellipsoids[s.ellipsoid].objectFromWorld, origin, dir, mode);
+    return intersectTrueSphere(s.anchorRadius, s.normal.xyz, origin, dir, mode);
 }
 
 // Slab test against a node's box (stored rounded outwards), within [0, tMax].

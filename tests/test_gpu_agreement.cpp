@@ -16,6 +16,7 @@
 #include "metrics/ImageMetrics.h"
 #include "reference/CpuRenderer.h"
 #include "scene/Parser.h"
+#include "gpu_test_context.h"
 #include "vulkan/VulkanContext.h"
 
 namespace fs = std::filesystem;
@@ -63,17 +64,7 @@ std::vector<Case> allCases() {
     return cases;
 }
 
-snell::vk::Context& context() {
-    static std::unique_ptr<snell::vk::Context> ctx = [] {
-        snell::vk::ContextOptions options;
-        // The Khronos validation layer watches every test when it is installed
-        // (the setup script installs it); it must report nothing.
-        const char* validation = std::getenv("SNELL_VALIDATION");
-        options.validation = validation && std::string(validation) == "1";
-        return std::make_unique<snell::vk::Context>(options);
-    }();
-    return *ctx;
-}
+snell::vk::Context& context() { return snell::testing::gpuContext(); }
 
 std::string testName(const testing::TestParamInfo<Case>& info) {
     std::string n = fs::path(info.param.path).parent_path().filename().string() + "_" +

@@ -1,0 +1,83 @@
+// Ray–sphere intersection in float32: the shader's half of the intersector
+// whose double twin is host/reference/Intersect.h (which explains the maths).
+// Pure functions of their arguments, included by trace.comp and by the test
+// kernel intersect_kernel.comp.
+//
+// Roots: Haines et al., "Precision Improvements for Ray/Sphere Intersection"
+// (Ray Tracing Gems ch. 7), the discriminant from the perpendicular vector and
+// the q-form roots. Self-intersection (SPEC §5) without an epsilon: a ray that
+// starts on a sphere and leaves it cannot hit it again; one that enters it hits
+// it at the exact chord root. A ray that starts within rounding distance of
+// another sphere's surface (a hit point on a touching or overlapping sphere)
+// starts just outside it: it hits it at once if it heads in, misses it if it
+// heads out; without that rule the sign of |f|² − r² is noise there and the
+// seams of overlapping spheres come out speckled.
+#ifndef SNELL_INTERSECT_GLSL
+#define SNELL_INTERSECT_GLSL
+
+const float NO_HIT = 3.0e38;
+// How a ray relates to a sphere it may start on.
+const uint ELSEWHERE = 0u;
+const uint LEAVING = 1u;
+const uint ENTERING = 2u;
+
+const float ROUNDING = 4.0 * 5.96e-8;  // 4 units of float32 rounding (2^-24)
+
+float rootsToHit(float b, float a, float c, float discriminant) {
+    // q-form: q = −(b + sign(b)·√Δ); roots c/q and q/a, no cancellation.
+    float q = -(b + (b >= 0.0 ? sqrt(discriminant) : -sqrt(discriminant)));
+    if (q == 0.0) return NO_HIT;
+    float t0 = c / q;
+    float t1 = q / a;
+    float near = min(t0, t1);
+    float far = max(t0, t1);
+    return near > 0.0 ? near : (far > 0.0 ? far : NO_HIT);
+}
+
+// The unit sphere seen through objectFromWorld (an ellipsoid).
+float intersectEllipsoid(mat4 objectFromWorld, vec3 origin, vec3 dir, uint mode) {
+    if (mode == LEAVING) return NO_HIT;
+    vec3 o = (objectFromWorld * vec4(origin, 1.0)).xyz;
+    vec3 d = mat3(objectFromWorld) * dir;
+    float a = dot(d, d);
+    float b = dot(o, d);
+    if (mode == ENTERING) {
+        float chord = -2.0 * b / a;
+        return chord > 0.0 ? chord : NO_HIT;
+    }
+    vec3 perpendicular = o - (b / a) * d;
+    float discriminant = a * (1.0 - dot(perpendicular, perpendicular));
+    if (discriminant < 0.0) return NO_HIT;
+    float lengthO = length(o);
+    // Rounding of o: of the origin through the matrix, and of the product.
+    mat3 m = mat3(objectFromWorld);
+    float matrixNorm = max(max(abs(m[0].x) + abs(m[1].x) + abs(m[2].x), abs(m[0].y) + abs(m[1].y) + abs(m[2].y)),
+                           abs(m[0].z) + abs(m[1].z) + abs(m[2].z));
+    if (abs(lengthO - 1.0) <= ROUNDING * (lengthO + 1.0 + matrixNorm * length(origin)))
+        return b < 0.0 ? 0.0 : NO_HIT;
+    return rootsToHit(b, a, dot(o, o) - 1.0, discriminant);
+}
+
+// A true sphere stored by its anchor (shared_layout.h): the surface point P0
+// (anchorRadius.xyz), the outward normal n0 there and the radius (anchorRadius.w).
+// With g = o − P0, o − centre = g + r n0 and |o − centre|² − r² = |g|² + 2r n0·g.
+float intersectTrueSphere(vec4 anchorRadius, vec3 n0, vec3 origin, vec3 dir, uint mode) {
+    if (mode == LEAVING) return NO_HIT;
+    vec3 g = origin - anchorRadius.xyz;
+    float r = anchorRadius.w;
+    float b = dot(g, dir) + r * dot(n0, dir);
+    if (mode == ENTERING) {
+        float chord = -2.0 * b;
+        return chord > 0.0 ? chord : NO_HIT;
+    }
+    vec3 f = g + r * n0;
+    vec3 perpendicular = f - b * dir;
+    float discriminant = r * r - dot(perpendicular, perpendicular);
+    if (discriminant < 0.0) return NO_HIT;
+    float c = dot(g, g) + 2.0 * r * dot(n0, g);
+    if (abs(c / (length(f) + r)) <= ROUNDING * (length(origin) + length(anchorRadius.xyz) + length(g)))
+        return b < 0.0 ? 0.0 : NO_HIT;
+    return rootsToHit(b, 1.0, c, discriminant);
+}
+
+#endif

@@ -1,0 +1,32 @@
+// Structs shared by the intersection test kernel (intersect_kernel.comp) and
+// its host side (tests/test_intersect_fuzz.cpp). vec4/mat4/uint members only.
+#ifndef SNELL_KERNEL_LAYOUT_H
+#define SNELL_KERNEL_LAYOUT_H
+
+#ifdef __cplusplus
+#include "shared_layout.h"
+namespace snell::gpu {
+#endif
+
+#define SNELL_KERNEL_GROUP_SIZE 64
+#define SNELL_CASE_TRUE_SPHERE 0u
+#define SNELL_CASE_ELLIPSOID 1u
+
+// One ray against one sphere, in the renderer's own float representation.
+struct IntersectCase {
+    vec4 origin;           // xyz
+    vec4 direction;        // xyz, unit
+    vec4 anchorRadius;     // true sphere: anchor P0 and radius
+    vec4 normal;           // true sphere: n0
+    mat4 objectFromWorld;  // ellipsoid
+    uint kind;             // SNELL_CASE_*
+    uint mode;             // 0 elsewhere, 1 leaving, 2 entering (intersect.glsl)
+    uint count;            // in the first case only: how many cases there are
+    uint pad0;
+};
+
+#ifdef __cplusplus
+static_assert(sizeof(IntersectCase) == 144);
+}  // namespace snell::gpu
+#endif
+#endif

@@ -1,0 +1,24 @@
+// The Vulkan context shared by the GPU tests of one test executable. No device
+// is a failure, never a skip; with SNELL_VALIDATION=1 the Khronos validation
+// layer watches every test.
+#pragma once
+
+#include <cstdlib>
+#include <memory>
+#include <string>
+
+#include "vulkan/VulkanContext.h"
+
+namespace snell::testing {
+
+inline vk::Context& gpuContext() {
+    static std::unique_ptr<vk::Context> context = [] {
+        vk::ContextOptions options;
+        const char* validation = std::getenv("SNELL_VALIDATION");
+        options.validation = validation && std::string(validation) == "1";
+        return std::make_unique<vk::Context>(options);
+    }();
+    return *context;
+}
+
+}  // namespace snell::testing
