@@ -283,12 +283,14 @@ GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool count
 
         // Record, submit and wait for one command buffer.
         double hostRenderMs = 0.0, gpuRenderMs = 0.0;
-        auto submit = [&](auto record, bool timed) {
+        // `setup` is recorded before the timed part, `record`.
+        auto submit = [&](auto setup, auto record, bool timed) {
             VkCommandBuffer cmd = p.commands;
             check(vkResetCommandBuffer(cmd, 0), "vkResetCommandBuffer");
             VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
             begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
             check(vkBeginCommandBuffer(cmd, &begin), "vkBeginCommandBuffer");
+            setup(cmd);
             if (timed && p.queries) {
                 vkCmdResetQueryPool(cmd, p.queries, 0, 2);
                 vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, p.queries, 0);
@@ -321,7 +323,7 @@ GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool count
             const auto warmStart = Clock::now();
             const gpu::TileParams empty{0, 0, 0, 0};
             std::memset(p.counters.mapped, 0, SNELL_COUNTER_COUNT * sizeof(std::uint32_t));
-            submit([&](VkCommandBuffer cmd) {
+            submit([](VkCommandBuffer) {}, [&](VkCommandBuffer cmd) {
                 imageBarrier(cmd, p.image.image, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL, 0,
                              VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT,
                              VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
@@ -367,6 +369,7 @@ GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool count
                                           VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT,
                                           VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
                         }
+                    }, [&](VkCommandBuffer cmd) {
                         vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.pipeline);
                         vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.layout, 0, 1, &p.set, 0, nullptr);
                         vkCmdPushConstants(cmd, p.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof tile, &tile);
@@ -392,7 +395,7 @@ GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool count
                     if (unfinished == 0) break;
                 }
                 // Copy the finished tile back.
-                submit([&](VkCommandBuffer cmd) {
+                submit([](VkCommandBuffer) {}, [&](VkCommandBuffer cmd) {
                     imageBarrier(cmd, p.image.image, VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
                                  VK_ACCESS_SHADER_WRITE_BIT, VK_ACCESS_TRANSFER_READ_BIT,
                                  VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT);
