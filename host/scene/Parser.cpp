@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <charconv>
 #include <cstring>
 #include <cerrno>
 #include <cmath>
@@ -11,6 +12,7 @@
 #include <map>
 #include <optional>
 #include <sstream>
+#include <unordered_map>
 #include <vector>
 
 #include "scene/Transform.h"
@@ -115,6 +117,17 @@ public:
     }
 
     Scene run() {
+        // Reserve for the spheres and materials the text can name at most, so
+        // a million-sphere file is not copied as the vectors grow.
+        auto occurrences = [this](std::string_view word) {
+            std::size_t count = 0;
+            for (std::size_t at = text_.find(word); at != std::string_view::npos; at = text_.find(word, at + 1))
+                ++count;
+            return count;
+        };
+        const std::size_t sphereCount = std::min(occurrences("sphere"), ParseLimits::kMaxSpheres);
+        scene_.spheres.reserve(sphereCount);
+        materialIndex_.reserve(std::min(sphereCount, occurrences("material") + occurrences("refraction")) + 1);
         std::size_t pos = 0;
         int lineNumber = 1;
         while (pos < text_.size()) {
@@ -243,10 +256,12 @@ private:
         const std::string_view s = t.text;
         std::size_t i = 0;
         if (i < s.size() && (s[i] == '+' || s[i] == '-')) ++i;
-        const std::string rest = lower(s.substr(i));
-        if (rest == "nan" || rest == "inf" || rest == "infinity" || rest.rfind("nan(", 0) == 0)
-            fail(t, quoted(s) + " is not allowed: numbers must be finite");
-        if (rest.size() >= 2 && rest[0] == '0' && rest[1] == 'x')
+        if (i < s.size() && std::isalpha(static_cast<unsigned char>(s[i]))) {
+            const std::string rest = lower(s.substr(i));
+            if (rest == "nan" || rest == "inf" || rest == "infinity" || rest.rfind("nan(", 0) == 0)
+                fail(t, quoted(s) + " is not allowed: numbers must be finite");
+        }
+        if (i + 1 < s.size() && s[i] == '0' && (s[i + 1] == 'x' || s[i + 1] == 'X'))
             fail(t, "hexadecimal number " + quoted(s) + " is not allowed: use decimal");
         std::size_t digits = 0;
         const std::size_t mantissaStart = i;
@@ -264,10 +279,17 @@ private:
             ok = expDigits > 0;
         }
         if (!ok || i != s.size()) fail(t, "expected a number, got " + quoted(s));
-        const std::string copy(s);
-        errno = 0;
-        const double v = std::strtod(copy.c_str(), nullptr);
-        if (!std::isfinite(v)) fail(t, "number " + quoted(s) + " overflows a double");
+        // The syntax is checked: convert without allocating (from_chars takes no '+').
+        const char* first = s.data() + (s[0] == '+' ? 1 : 0);
+        double v = 0.0;
+        const auto [end, error] = std::from_chars(first, s.data() + s.size(), v);
+        if (error == std::errc::result_out_of_range) {
+            // Overflow is an error (SPEC §1); underflow rounds towards zero.
+            const std::string copy(s);
+            v = std::strtod(copy.c_str(), nullptr);
+        }
+        if (!std::isfinite(v) || end != s.data() + s.size())
+            fail(t, "number " + quoted(s) + " overflows a double");
         return v;
     }
 
@@ -394,8 +416,8 @@ private:
         Sphere s;
         s.worldFromObject = state_.transform.worldFromObject();
         s.objectFromWorld = state_.transform.objectFromWorld();
-        s.location = here(tokens_[0]);
-        s.material = internMaterial(state_.material, s.location);
+        s.location = {line_, tokens_[0].column};
+        s.material = internMaterial(state_.material, here(tokens_[0]));
         classifySphere(s);
         scene_.spheres.push_back(std::move(s));
     }
@@ -403,11 +425,12 @@ private:
     std::uint32_t internMaterial(const Material& m, const SourceLocation& where) {
         // Most scenes reuse a handful of materials: deduplicate them.
         if (!scene_.materials.empty() && scene_.materials[lastMaterial_] == m) return lastMaterial_;
-        for (std::size_t i = 0; i < scene_.materials.size(); ++i)
-            if (scene_.materials[i] == m) return lastMaterial_ = static_cast<std::uint32_t>(i);
-        scene_.materials.push_back(m);
-        amplifyingLocation_.push_back(where);
-        return lastMaterial_ = static_cast<std::uint32_t>(scene_.materials.size() - 1);
+        const auto [it, inserted] = materialIndex_.try_emplace(m, static_cast<std::uint32_t>(scene_.materials.size()));
+        if (inserted) {
+            scene_.materials.push_back(m);
+            amplifyingLocation_.push_back(where);
+        }
+        return lastMaterial_ = it->second;
     }
 
     SourceLocation here(const Token& t) const { return {file_, line_, t.column}; }
@@ -429,6 +452,7 @@ private:
     std::optional<SourceLocation> viewLocation_;
     std::vector<SourceLocation> amplifyingLocation_;
     std::uint32_t lastMaterial_ = 0;
+    std::unordered_map<Material, std::uint32_t, MaterialHash> materialIndex_;
 };
 
 }  // namespace
@@ -447,12 +471,24 @@ Scene parseSceneFile(const std::string& path) {
     };
     std::error_code ec;
     if (std::filesystem::is_directory(path, ec)) throw fileError("is a directory, not a scene file");
-    std::ifstream in(path, std::ios::binary);
+    std::ifstream in(path, std::ios::binary | std::ios::ate);
     if (!in) throw fileError(std::string("cannot open scene file: ") + std::strerror(errno));
-    std::ostringstream buffer;
-    buffer << in.rdbuf();
+    std::string text;
+    const std::streamoff size = in.tellg();
+    if (size > 0) {
+        text.resize(static_cast<std::size_t>(size));
+        in.seekg(0);
+        in.read(text.data(), size);
+    } else {
+        // Not a regular file (a pipe, say): read until the end.
+        in.clear();
+        in.seekg(0);
+        std::ostringstream buffer;
+        buffer << in.rdbuf();
+        text = buffer.str();
+    }
     if (in.bad()) throw fileError("cannot read scene file");
-    return parseScene(buffer.str(), path);
+    return parseScene(text, path);
 }
 
 }  // namespace snell

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -40,12 +41,34 @@ struct Material {
     bool operator==(const Material&) const = default;
 };
 
+// Hash of a material's values, for deduplicating materials while parsing.
+struct MaterialHash {
+    std::size_t operator()(const Material& m) const {
+        std::size_t h = 0;
+        auto mix = [&h](double v) { h = h * 1099511628211ull ^ std::hash<double>()(v); };
+        for (int k = 0; k < 3; ++k) {
+            mix(m.kd[k]);
+            mix(m.ks[k]);
+            mix(m.kt[k]);
+        }
+        mix(m.phong);
+        mix(m.eta);
+        return h;
+    }
+};
+
+// A place in the scene's own file (the file name is the scene's).
+struct TextPosition {
+    int line = 1;
+    int column = 1;
+};
+
 // The unit sphere at the origin seen through worldFromObject (SPEC §2 `sphere`).
 struct Sphere {
     dmat4 worldFromObject{1.0};
     dmat4 objectFromWorld{1.0};
     std::uint32_t material = 0;
-    SourceLocation location;
+    TextPosition location;  // of its `sphere` command
 
     // A similarity (rotation, uniform scale, translation) maps the unit sphere to
     // a true sphere, stored and intersected as centre + radius; anything else is
