@@ -5,5 +5,9 @@ cd "$(dirname "$0")/.."
 bash scripts/setup.sh
 # The Khronos validation layer watches the GPU tests; any message fails them.
 export SNELL_VALIDATION=1
-cd build
-ctest --output-on-failure --timeout 900 "$@"
+(cd build && ctest --output-on-failure --timeout 900 "$@")
+
+# The same suite built with AddressSanitizer and UndefinedBehaviorSanitizer.
+cmake -S . -B build-sanitize -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSNELL_SANITIZE=ON >/dev/null
+cmake --build build-sanitize --parallel
+(cd build-sanitize && ctest --output-on-failure --timeout 900 "$@")
