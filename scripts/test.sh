@@ -11,3 +11,6 @@ export SNELL_VALIDATION=1
 cmake -S . -B build-sanitize -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo -DSNELL_SANITIZE=ON >/dev/null
 cmake --build build-sanitize --parallel
 (cd build-sanitize && ctest --output-on-failure --timeout 900 "$@")
+
+# Short libFuzzer runs of the parser and of parser + CPU renderer.
+bash tests/fuzz_test.sh
