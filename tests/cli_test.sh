@@ -63,5 +63,14 @@ head -c 2 "$work/basic.pfm" | grep -q PF && ok || bad "PFM magic"
 "$SNELL" render "$SCENES/basic.scn" --size 32 --cpu -o "$work/cpu.png" 2>/dev/null && ok || bad "--cpu"
 "$SNELL" compare "$work/basic.png" "$work/cpu.png" >"$work/cmp" && grep -q mean_abs_error "$work/cmp" && ok || bad "compare"
 
+# Ctrl-C during a long render: status 130, no output file, no temporary left.
+"$SNELL" render "$SCENES/showcase.scn" --size 4096 --cpu -o "$work/interrupted.png" 2>/dev/null &
+pid=$!
+sleep 1
+kill -INT $pid
+wait $pid; status=$?
+[ $status -eq 130 ] && [ ! -e "$work/interrupted.png" ] && ! ls "$work" | grep -q "interrupted.png.tmp" && ok ||
+  bad "interrupted render (status $status): $(ls "$work")"
+
 echo "cli: $pass passed, $fail failed"
 [ $fail -eq 0 ]

@@ -132,7 +132,36 @@ int runRender(const RenderOptions& o) {
     Progress progress(!o.quiet);
     request.progress = progress.callback();
 
-    snell::Image image;
+    // The image streams to a temporary file beside the output as bands of
+    // rows finish; it replaces the output only when complete.
+    std::unique_ptr<snell::ImageWriter> writer;
+    double writeMs = 0.0;
+    try {
+        const std::string settings =
+            "size " + std::to_string(size) + ", supersample " + std::to_string(request.supersample) + ", depth " +
+            std::to_string(request.trace.maxDepth) + ", min-weight " + std::to_string(request.trace.minWeight) +
+            ", " + (o.cpu ? "CPU reference" : "GPU");
+        writer = snell::ImageWriter::open(output, size, size,
+                                          {{"Title", scene.name},
+                                           {"Source", o.scene},
+                                           {"Software", std::string("snell ") + SNELL_VERSION},
+                                           {"Comment", settings}});
+    } catch (const snell::ImageIOError& e) {
+        std::cerr << "snell: error: " << e.what() << "\n";
+        return kExitRuntime;
+    }
+    std::string writeError;
+    request.rowSink = [&](const float* rgb, int rows) {
+        if (!writeError.empty()) return;
+        const auto start = Clock::now();
+        try {
+            writer->writeRows(rgb, rows);
+        } catch (const snell::ImageIOError& e) {
+            writeError = e.what();
+        }
+        writeMs += msSince(start);
+    };
+
     snell::RayCounts rays;
     double uploadMs = 0, pipelineMs = 0, renderMs = 0, readbackMs = 0;
     int tiles = 0, dispatches = 0;
@@ -141,8 +170,8 @@ int runRender(const RenderOptions& o) {
     if (o.cpu) {
         const auto start = Clock::now();
         snell::CpuRenderer renderer(scene);
-        image = renderer.render(request, &rays);
-        renderMs = msSince(start);
+        renderer.render(request, &rays);
+        renderMs = msSince(start) - writeMs;
         device = "CPU reference (double, " + std::to_string(std::max(1u, std::thread::hardware_concurrency())) + " threads)";
         timing = "host";
     } else {
@@ -160,7 +189,6 @@ int runRender(const RenderOptions& o) {
             snell::ComputeRenderer renderer(context, scene, request.camera);
             uploadMs = renderer.uploadMs();
             snell::GpuRenderResult r = renderer.render(request, o.stats);
-            image = std::move(r.image);
             rays = r.rays;
             renderMs = r.renderMs;
             pipelineMs = r.pipelineMs;
@@ -186,14 +214,18 @@ int runRender(const RenderOptions& o) {
         std::cerr << "\nsnell: interrupted; no image written\n";
         return kExitInterrupted;
     }
-    const auto writeStart = Clock::now();
+    if (!writeError.empty()) {
+        std::cerr << "snell: error: " << writeError << "\n";
+        return kExitRuntime;
+    }
+    const auto commitStart = Clock::now();
     try {
-        snell::writeImage(output, image);
+        writer->commit();
     } catch (const snell::ImageIOError& e) {
         std::cerr << "snell: error: " << e.what() << "\n";
         return kExitRuntime;
     }
-    const double writeMs = msSince(writeStart);
+    writeMs += msSince(commitStart);
     if (o.stats) {
         std::ostringstream j;
         j.precision(6);

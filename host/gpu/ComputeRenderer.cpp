@@ -217,7 +217,7 @@ GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool count
     if (request.camera.eye != layout_.eye)
         throw vk::VulkanError("internal error: the camera moved without rebuilding the GPU scene");
     GpuRenderResult result;
-    result.image = Image(request.width, request.height);
+    if (!request.rowSink) result.image = Image(request.width, request.height);
     Pipeline p;
     VkDevice device = context_.device();
     try {
@@ -335,6 +335,8 @@ GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool count
             result.pipelineMs += msSince(warmStart);
         }
 
+        // Streaming rows: one band of tile rows at a time.
+        Image band = request.rowSink ? Image(request.width, tileH) : Image();
         const int tilesX = (request.width + tileW - 1) / tileW;
         const int tilesY = (request.height + tileH - 1) / tileH;
         const int tileCount = tilesX * tilesY;
@@ -411,7 +413,8 @@ GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool count
                 const auto readStart = Clock::now();
                 const auto* texels = static_cast<const float*>(p.readback.mapped);
                 for (std::uint32_t y = 0; y < tile.height; ++y) {
-                    float* row = result.image.pixel(tile.originX, tile.originY + y);
+                    float* row = request.rowSink ? band.pixel(tile.originX, y)
+                                                 : result.image.pixel(tile.originX, tile.originY + y);
                     const float* src = texels + std::size_t(y) * tileW * 4;
                     for (std::uint32_t x = 0; x < tile.width; ++x) {
                         row[x * 3 + 0] = src[x * 4 + 0];
@@ -423,6 +426,7 @@ GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool count
                 imageUsed = true;
                 ++result.tiles;
             }
+            if (request.rowSink) request.rowSink(band.rgb.data(), std::min(tileH, request.height - ty * tileH));
         }
         result.gpuTimed = p.queries != VK_NULL_HANDLE;
         result.renderMs = result.gpuTimed ? gpuRenderMs : hostRenderMs;

@@ -1,21 +1,18 @@
 #include "image/ImageIO.h"
 
 #include <cerrno>
-#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <random>
 #include <sstream>
-#include <vector>
 
+#include <png.h>
 #include <unistd.h>
 
-#define STB_IMAGE_WRITE_IMPLEMENTATION
 #define STB_IMAGE_IMPLEMENTATION
 #define STBI_ONLY_PNG
 #include <stb/stb_image.h>
-#include <stb/stb_image_write.h>
 
 namespace snell {
 namespace fs = std::filesystem;
@@ -28,41 +25,109 @@ std::string extensionOf(const std::string& path) {
     return ext;
 }
 
-std::vector<std::uint8_t> toBytes(const Image& image) {
-    std::vector<std::uint8_t> bytes(image.rgb.size());
-    for (std::size_t i = 0; i < bytes.size(); ++i) bytes[i] = toByte(image.rgb[i]);
-    return bytes;
-}
+std::string errorText() { return std::strerror(errno); }
 
-std::string encode(const Image& image, ImageFormat format) {
-    std::string out;
-    switch (format) {
-    case ImageFormat::Png: {
-        const std::vector<std::uint8_t> bytes = toBytes(image);
-        auto append = [](void* context, void* data, int size) {
-            static_cast<std::string*>(context)->append(static_cast<const char*>(data), size);
-        };
-        if (!stbi_write_png_to_func(append, &out, image.width, image.height, 3, bytes.data(), image.width * 3))
-            throw ImageIOError("PNG encoding failed");
-        break;
+// PPM P6: header, then 8-bit rows top to bottom.
+class PpmWriter : public ImageWriter {
+public:
+    PpmWriter(std::string path, int width, int height) : ImageWriter(std::move(path), width, height) {
+        const std::string header = "P6\n" + std::to_string(width) + " " + std::to_string(height) + "\n255\n";
+        if (std::fwrite(header.data(), 1, header.size(), file_) != header.size())
+            throw ImageIOError("cannot write '" + path_ + "': " + errorText());
+        row_.resize(std::size_t(width) * 3);
     }
-    case ImageFormat::Ppm: {
-        out = "P6\n" + std::to_string(image.width) + " " + std::to_string(image.height) + "\n255\n";
-        const std::vector<std::uint8_t> bytes = toBytes(image);
-        out.append(reinterpret_cast<const char*>(bytes.data()), bytes.size());
-        break;
+    void writeRows(const float* rgb, int rows) override {
+        for (int r = 0; r < rows; ++r, rgb += std::size_t(width_) * 3) {
+            for (std::size_t i = 0; i < row_.size(); ++i) row_[i] = toByte(rgb[i]);
+            if (std::fwrite(row_.data(), 1, row_.size(), file_) != row_.size())
+                throw ImageIOError("cannot write '" + path_ + "': " + errorText());
+        }
+        rowsWritten_ += rows;
     }
-    case ImageFormat::Pfm: {
-        // PFM: rows bottom to top, negative scale = little-endian floats.
-        out = "PF\n" + std::to_string(image.width) + " " + std::to_string(image.height) + "\n-1.0\n";
-        const std::size_t row = static_cast<std::size_t>(image.width) * 3;
-        for (int y = image.height - 1; y >= 0; --y)
-            out.append(reinterpret_cast<const char*>(image.pixel(0, y)), row * sizeof(float));
-        break;
+
+private:
+    void finish() override {}
+    std::vector<unsigned char> row_;
+};
+
+// PFM: rows are stored bottom to top, so each row goes to its own offset.
+class PfmWriter : public ImageWriter {
+public:
+    PfmWriter(std::string path, int width, int height) : ImageWriter(std::move(path), width, height) {
+        const std::string header = "PF\n" + std::to_string(width) + " " + std::to_string(height) + "\n-1.0\n";
+        headerBytes_ = static_cast<long>(header.size());
+        if (std::fwrite(header.data(), 1, header.size(), file_) != header.size())
+            throw ImageIOError("cannot write '" + path_ + "': " + errorText());
     }
+    void writeRows(const float* rgb, int rows) override {
+        const long rowBytes = long(width_) * 3 * long(sizeof(float));
+        for (int r = 0; r < rows; ++r, rgb += std::size_t(width_) * 3) {
+            const long y = rowsWritten_ + r;
+            if (std::fseek(file_, headerBytes_ + (height_ - 1 - y) * rowBytes, SEEK_SET) != 0 ||
+                std::fwrite(rgb, 1, std::size_t(rowBytes), file_) != std::size_t(rowBytes))
+                throw ImageIOError("cannot write '" + path_ + "': " + errorText());
+        }
+        rowsWritten_ += rows;
     }
-    return out;
-}
+
+private:
+    void finish() override {}
+    long headerBytes_ = 0;
+};
+
+// PNG through libpng, row by row; text chunks name the scene and settings.
+class PngWriter : public ImageWriter {
+public:
+    PngWriter(std::string path, int width, int height, const ImageText& text)
+        : ImageWriter(std::move(path), width, height) {
+        png_ = png_create_write_struct(PNG_LIBPNG_VER_STRING, this, onError, onWarning);
+        info_ = png_ ? png_create_info_struct(png_) : nullptr;
+        if (!png_ || !info_) throw ImageIOError("cannot start a PNG encoder (out of memory)");
+        std::vector<png_text> chunks(text.size());
+        for (std::size_t i = 0; i < text.size(); ++i) {
+            chunks[i].compression = PNG_TEXT_COMPRESSION_NONE;
+            chunks[i].key = const_cast<char*>(text[i].first.c_str());
+            chunks[i].text = const_cast<char*>(text[i].second.c_str());
+        }
+        guard([&] {
+            png_init_io(png_, file_);
+            png_set_IHDR(png_, info_, std::uint32_t(width), std::uint32_t(height), 8, PNG_COLOR_TYPE_RGB,
+                         PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+            if (!chunks.empty()) png_set_text(png_, info_, chunks.data(), int(chunks.size()));
+            png_write_info(png_, info_);
+        });
+        row_.resize(std::size_t(width) * 3);
+    }
+    ~PngWriter() override { png_destroy_write_struct(&png_, &info_); }
+    void writeRows(const float* rgb, int rows) override {
+        for (int r = 0; r < rows; ++r, rgb += std::size_t(width_) * 3) {
+            for (std::size_t i = 0; i < row_.size(); ++i) row_[i] = toByte(rgb[i]);
+            guard([&] { png_write_row(png_, row_.data()); });
+        }
+        rowsWritten_ += rows;
+    }
+
+private:
+    void finish() override {
+        guard([&] { png_write_end(png_, nullptr); });
+    }
+    // libpng reports errors by longjmp; turn them into exceptions here.
+    template <typename F>
+    void guard(F f) {
+        if (setjmp(png_jmpbuf(png_))) throw ImageIOError("cannot write '" + path_ + "': " + message_);
+        f();
+    }
+    static void onError(png_structp png, png_const_charp message) {
+        static_cast<PngWriter*>(png_get_error_ptr(png))->message_ = message ? message : "PNG error";
+        png_longjmp(png, 1);
+    }
+    static void onWarning(png_structp, png_const_charp) {}
+
+    png_structp png_ = nullptr;
+    png_infop info_ = nullptr;
+    std::string message_;
+    std::vector<unsigned char> row_;
+};
 
 }  // namespace
 
@@ -84,40 +149,59 @@ void checkWritable(const std::string& path) {
     if (!fs::is_directory(dir, ec))
         throw ImageIOError("cannot write '" + path + "': directory '" + dir.string() + "' does not exist");
     if (::access(dir.c_str(), W_OK) != 0)
-        throw ImageIOError("cannot write '" + path + "': directory '" + dir.string() +
-                           "' is not writable (" + std::strerror(errno) + ")");
+        throw ImageIOError("cannot write '" + path + "': directory '" + dir.string() + "' is not writable (" +
+                           errorText() + ")");
     if (fs::exists(p) && ::access(p.c_str(), W_OK) != 0)
-        throw ImageIOError("cannot write '" + path + "': the file is not writable (" +
-                           std::strerror(errno) + ")");
+        throw ImageIOError("cannot write '" + path + "': the file is not writable (" + errorText() + ")");
 }
 
-void writeImage(const std::string& path, const Image& image) {
-    const std::string data = encode(image, formatForPath(path));
+ImageWriter::ImageWriter(std::string path, int width, int height)
+    : path_(std::move(path)), width_(width), height_(height) {
     // A unique temporary name in the same directory, so rename() is atomic.
     std::random_device random;
-    const std::string temporary = path + ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(random());
-    {
-        std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-        if (!out) throw ImageIOError("cannot create '" + temporary + "': " + std::strerror(errno));
-        out.write(data.data(), static_cast<std::streamsize>(data.size()));
-        out.flush();
-        if (!out) {
-            const std::string reason = std::strerror(errno);
-            out.close();
-            std::remove(temporary.c_str());
-            throw ImageIOError("cannot write '" + path + "': " + reason);
-        }
+    temporary_ = path_ + ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(random());
+    file_ = std::fopen(temporary_.c_str(), "wb");
+    if (!file_) throw ImageIOError("cannot create '" + temporary_ + "': " + errorText());
+}
+
+ImageWriter::~ImageWriter() {
+    if (file_) std::fclose(file_);
+    if (!committed_) std::remove(temporary_.c_str());
+}
+
+std::unique_ptr<ImageWriter> ImageWriter::open(const std::string& path, int width, int height,
+                                               const ImageText& text) {
+    switch (formatForPath(path)) {
+    case ImageFormat::Png: return std::unique_ptr<ImageWriter>(new PngWriter(path, width, height, text));
+    case ImageFormat::Ppm: return std::unique_ptr<ImageWriter>(new PpmWriter(path, width, height));
+    case ImageFormat::Pfm: return std::unique_ptr<ImageWriter>(new PfmWriter(path, width, height));
     }
-    if (std::rename(temporary.c_str(), path.c_str()) != 0) {
-        const std::string reason = std::strerror(errno);
-        std::remove(temporary.c_str());
-        throw ImageIOError("cannot write '" + path + "': " + reason);
-    }
+    throw ImageIOError("unknown image format");
+}
+
+void ImageWriter::commit() {
+    if (rowsWritten_ != height_)
+        throw ImageIOError("internal error: " + std::to_string(rowsWritten_) + " of " + std::to_string(height_) +
+                           " rows written to '" + path_ + "'");
+    finish();
+    const bool flushed = std::fflush(file_) == 0 && ::fsync(fileno(file_)) == 0;
+    const int closed = std::fclose(file_);
+    file_ = nullptr;
+    if (!flushed || closed != 0) throw ImageIOError("cannot write '" + path_ + "': " + errorText());
+    if (std::rename(temporary_.c_str(), path_.c_str()) != 0)
+        throw ImageIOError("cannot write '" + path_ + "': " + errorText());
+    committed_ = true;
+}
+
+void writeImage(const std::string& path, const Image& image, const ImageText& text) {
+    auto writer = ImageWriter::open(path, image.width, image.height, text);
+    writer->writeRows(image.rgb.data(), image.height);
+    writer->commit();
 }
 
 Image readImage(const std::string& path) {
     std::ifstream in(path, std::ios::binary);
-    if (!in) throw ImageIOError("cannot open '" + path + "': " + std::strerror(errno));
+    if (!in) throw ImageIOError("cannot open '" + path + "': " + errorText());
     std::ostringstream buffer;
     buffer << in.rdbuf();
     const std::string data = buffer.str();

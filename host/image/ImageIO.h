@@ -1,11 +1,16 @@
 // Image files: PNG (8-bit), PPM P6 (8-bit) and PFM (float, unclamped), chosen
-// by extension. Writes are atomic: a temporary file beside the target, renamed
-// over it only when complete, so a failed or interrupted write never leaves a
-// partial or clobbered file.
+// by extension. Writing streams rows (an image of any size is written with
+// bounded memory) into a temporary file beside the target, renamed over it
+// only on commit(), so a failed or interrupted write never leaves a partial or
+// clobbered file.
 #pragma once
 
+#include <cstdio>
+#include <memory>
 #include <stdexcept>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "image/Image.h"
 
@@ -25,7 +30,32 @@ ImageFormat formatForPath(const std::string& path);
 // a writable directory. Throws ImageIOError with the reason.
 void checkWritable(const std::string& path);
 
-void writeImage(const std::string& path, const Image& image);
+// Text stored with the image where the format allows (PNG tEXt chunks).
+using ImageText = std::vector<std::pair<std::string, std::string>>;
+
+// Rows of width × 3 floats, top to bottom, in one or more calls.
+class ImageWriter {
+public:
+    // Opens a temporary file beside `path`. Throws ImageIOError.
+    static std::unique_ptr<ImageWriter> open(const std::string& path, int width, int height,
+                                             const ImageText& text = {});
+    virtual ~ImageWriter();
+    // The next `rows` rows (rgb floats, width * 3 per row).
+    virtual void writeRows(const float* rgb, int rows) = 0;
+    // All rows written: finish the file and rename it over the target.
+    void commit();
+
+protected:
+    ImageWriter(std::string path, int width, int height);
+    virtual void finish() = 0;
+    std::string path_, temporary_;
+    std::FILE* file_ = nullptr;
+    int width_, height_;
+    int rowsWritten_ = 0;
+    bool committed_ = false;
+};
+
+void writeImage(const std::string& path, const Image& image, const ImageText& text = {});
 Image readImage(const std::string& path);
 
 }  // namespace snell

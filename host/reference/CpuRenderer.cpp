@@ -281,32 +281,43 @@ glm::dvec3 CpuRenderer::renderPixel(const RenderRequest& request, int x, int y, 
 }
 
 Image CpuRenderer::render(const RenderRequest& request, RayCounts* counts) const {
-    Image image(request.width, request.height);
+    // Bands of rows: all of them at once for an image in memory, 32 at a time
+    // when the rows stream to a sink.
+    const int bandRows = request.rowSink ? std::min(32, request.height) : request.height;
+    Image band(request.width, bandRows);
+    Image image = request.rowSink ? Image() : Image(request.width, request.height);
     const int threads = request.threads > 0
                             ? request.threads
                             : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-    std::atomic<int> nextRow{0};
-    std::atomic<int> rowsDone{0};
     std::vector<RayCounts> perThread(threads);
-    auto work = [&](int id) {
-        RayCounts& local = perThread[id];
-        for (int y; (y = nextRow.fetch_add(1)) < request.height;) {
-            if (request.cancel && request.cancel->load()) return;
-            for (int x = 0; x < request.width; ++x) {
-                const dvec3 c = renderPixel(request, x, y, local);
-                float* p = image.pixel(x, y);
-                p[0] = static_cast<float>(c.x);
-                p[1] = static_cast<float>(c.y);
-                p[2] = static_cast<float>(c.z);
+    std::atomic<int> rowsDone{0};
+    for (int bandStart = 0; bandStart < request.height; bandStart += bandRows) {
+        const int rows = std::min(bandRows, request.height - bandStart);
+        Image& target = request.rowSink ? band : image;
+        const int targetOffset = request.rowSink ? bandStart : 0;
+        std::atomic<int> nextRow{bandStart};
+        auto work = [&](int id) {
+            RayCounts& local = perThread[id];
+            for (int y; (y = nextRow.fetch_add(1)) < bandStart + rows;) {
+                if (request.cancel && request.cancel->load()) return;
+                for (int x = 0; x < request.width; ++x) {
+                    const dvec3 c = renderPixel(request, x, y, local);
+                    float* p = target.pixel(x, y - targetOffset);
+                    p[0] = static_cast<float>(c.x);
+                    p[1] = static_cast<float>(c.y);
+                    p[2] = static_cast<float>(c.z);
+                }
+                const int done = rowsDone.fetch_add(1) + 1;
+                if (request.progress) request.progress(static_cast<double>(done) / request.height);
             }
-            const int done = rowsDone.fetch_add(1) + 1;
-            if (request.progress) request.progress(static_cast<double>(done) / request.height);
-        }
-    };
-    std::vector<std::thread> pool;
-    for (int t = 1; t < threads; ++t) pool.emplace_back(work, t);
-    work(0);
-    for (std::thread& t : pool) t.join();
+        };
+        std::vector<std::thread> pool;
+        for (int t = 1; t < threads; ++t) pool.emplace_back(work, t);
+        work(0);
+        for (std::thread& t : pool) t.join();
+        if (request.cancel && request.cancel->load()) break;
+        if (request.rowSink) request.rowSink(band.rgb.data(), rows);
+    }
     if (counts) {
         *counts = RayCounts{};
         for (const RayCounts& c : perThread) {

@@ -39,6 +39,10 @@ struct RenderRequest {
     std::function<void(double)> progress;
     // Set to true from anywhere to stop early (the result is then incomplete).
     const std::atomic<bool>* cancel = nullptr;
+    // When set, finished rows go here, top to bottom (width * 3 floats per
+    // row), and the renderer keeps only a band of rows, not the whole image:
+    // the returned image is then empty.
+    std::function<void(const float* rgb, int rows)> rowSink;
 };
 
 }  // namespace snell
