@@ -335,9 +335,6 @@ private:
         const long long n = integer(1, "view: image size n", 1, ParseLimits::kMaxImageSize);
         const double d = number(2);
         if (!(d > 0.0)) fail(tokens_[2], "view: half-width d must be > 0, got " + quoted(tokens_[2].text));
-        if (viewLocation_)
-            fail(tokens_[0], "second 'view' command (the first is at line " +
-                                 std::to_string(viewLocation_->line) + "); a scene has exactly one");
         viewLocation_ = here(tokens_[0]);
         scene_.imageSize = static_cast<int>(n);
         scene_.halfWidth = d;
@@ -372,8 +369,6 @@ private:
     }
 
     void light() {
-        if (scene_.lights.size() >= ParseLimits::kMaxLights)
-            fail(tokens_[0], "too many lights: snell's limit is " + std::to_string(ParseLimits::kMaxLights));
         Light l;
         l.colour = colour(1, "light colour");
         for (int k = 0; k < 3; ++k) l.position[k] = number(4 + k);
@@ -394,25 +389,17 @@ private:
     }
 
     void group() {
-        if (groupStack_.size() >= static_cast<std::size_t>(ParseLimits::kMaxGroupDepth))
-            fail(tokens_[0], "groups nested deeper than snell's limit of " +
-                                 std::to_string(ParseLimits::kMaxGroupDepth) + " levels");
         groupStack_.push_back(state_);
         groupStack_locations_.push_back(here(tokens_[0]));
     }
 
     void groupEnd() {
-        if (groupStack_.empty()) fail(tokens_[0], "'groupend' without a matching 'group'");
         state_ = groupStack_.back();
         groupStack_.pop_back();
         groupStack_locations_.pop_back();
     }
 
     void sphere() {
-        if (scene_.spheres.size() >= ParseLimits::kMaxSpheres)
-            fail(tokens_[0], "too many spheres: snell's limit is " + std::to_string(ParseLimits::kMaxSpheres));
-        if (!state_.transform.invertible())
-            fail(tokens_[0], "the current transform is degenerate (not invertible in double precision)");
         Sphere s;
         s.worldFromObject = state_.transform.worldFromObject();
         s.objectFromWorld = state_.transform.objectFromWorld();
@@ -444,7 +431,6 @@ private:
     std::string file_;
     int line_ = 1;
     std::vector<Token> tokens_;
-    std::vector<double> args_;
     Scene scene_;
     State state_;
     std::vector<State> groupStack_;
