@@ -1,4 +1,5 @@
-// Ray–sphere intersection in float32: the shader's half of the intersector
+// Ray–sphere intersection in the shader's precision (precision.glsl, float32
+// unless SNELL_FP64): the shader's half of the intersector
 // whose double twin is host/reference/Intersect.h (which explains the maths).
 // Pure functions of their arguments, included by trace.comp and by the test
 // kernel intersect_kernel.comp.
@@ -14,44 +15,45 @@
 // seams of overlapping spheres come out speckled.
 #ifndef SNELL_INTERSECT_GLSL
 #define SNELL_INTERSECT_GLSL
+#include "precision.glsl"
 
-const float NO_HIT = 3.0e38;
+const real NO_HIT = 3.0e38;
 // How a ray relates to a sphere it may start on.
 const uint ELSEWHERE = 0u;
 const uint LEAVING = 1u;
 const uint ENTERING = 2u;
 
-const float ROUNDING = 4.0 * 5.96e-8;  // 4 units of float32 rounding (2^-24)
+const real ROUNDING = 4.0 * UNIT_ROUNDOFF;  // 4 units of rounding
 
-float rootsToHit(float b, float a, float c, float discriminant) {
+real rootsToHit(real b, real a, real c, real discriminant) {
     // q-form: q = −(b + sign(b)·√Δ); roots c/q and q/a, no cancellation.
-    float q = -(b + (b >= 0.0 ? sqrt(discriminant) : -sqrt(discriminant)));
+    real q = -(b + (b >= 0.0 ? sqrt(discriminant) : -sqrt(discriminant)));
     if (q == 0.0) return NO_HIT;
-    float t0 = c / q;
-    float t1 = q / a;
-    float near = min(t0, t1);
-    float far = max(t0, t1);
+    real t0 = c / q;
+    real t1 = q / a;
+    real near = min(t0, t1);
+    real far = max(t0, t1);
     return near > 0.0 ? near : (far > 0.0 ? far : NO_HIT);
 }
 
 // The unit sphere seen through objectFromWorld (an ellipsoid).
-float intersectEllipsoid(mat4 objectFromWorld, vec3 origin, vec3 dir, uint mode) {
+real intersectEllipsoid(rmat4 objectFromWorld, rvec3 origin, rvec3 dir, uint mode) {
     if (mode == LEAVING) return NO_HIT;
-    vec3 o = (objectFromWorld * vec4(origin, 1.0)).xyz;
-    vec3 d = mat3(objectFromWorld) * dir;
-    float a = dot(d, d);
-    float b = dot(o, d);
+    rvec3 o = (objectFromWorld * rvec4(origin, 1.0)).xyz;
+    rvec3 d = rmat3(objectFromWorld) * dir;
+    real a = dot(d, d);
+    real b = dot(o, d);
     if (mode == ENTERING) {
-        float chord = -2.0 * b / a;
+        real chord = -2.0 * b / a;
         return chord > 0.0 ? chord : NO_HIT;
     }
-    vec3 perpendicular = o - (b / a) * d;
-    float discriminant = a * (1.0 - dot(perpendicular, perpendicular));
+    rvec3 perpendicular = o - (b / a) * d;
+    real discriminant = a * (1.0 - dot(perpendicular, perpendicular));
     if (discriminant < 0.0) return NO_HIT;
-    float lengthO = length(o);
+    real lengthO = length(o);
     // Rounding of o: of the origin through the matrix, and of the product.
-    mat3 m = mat3(objectFromWorld);
-    float matrixNorm = max(max(abs(m[0].x) + abs(m[1].x) + abs(m[2].x), abs(m[0].y) + abs(m[1].y) + abs(m[2].y)),
+    rmat3 m = rmat3(objectFromWorld);
+    real matrixNorm = max(max(abs(m[0].x) + abs(m[1].x) + abs(m[2].x), abs(m[0].y) + abs(m[1].y) + abs(m[2].y)),
                            abs(m[0].z) + abs(m[1].z) + abs(m[2].z));
     if (abs(lengthO - 1.0) <= ROUNDING * (lengthO + 1.0 + matrixNorm * length(origin)))
         return b < 0.0 ? 0.0 : NO_HIT;
@@ -61,20 +63,20 @@ float intersectEllipsoid(mat4 objectFromWorld, vec3 origin, vec3 dir, uint mode)
 // A true sphere stored by its anchor (shared_layout.h): the surface point P0
 // (anchorRadius.xyz), the outward normal n0 there and the radius (anchorRadius.w).
 // With g = o − P0, o − centre = g + r n0 and |o − centre|² − r² = |g|² + 2r n0·g.
-float intersectTrueSphere(vec4 anchorRadius, vec3 n0, vec3 origin, vec3 dir, uint mode) {
+real intersectTrueSphere(rvec4 anchorRadius, rvec3 n0, rvec3 origin, rvec3 dir, uint mode) {
     if (mode == LEAVING) return NO_HIT;
-    vec3 g = origin - anchorRadius.xyz;
-    float r = anchorRadius.w;
-    float b = dot(g, dir) + r * dot(n0, dir);
+    rvec3 g = origin - anchorRadius.xyz;
+    real r = anchorRadius.w;
+    real b = dot(g, dir) + r * dot(n0, dir);
     if (mode == ENTERING) {
-        float chord = -2.0 * b;
+        real chord = -2.0 * b;
         return chord > 0.0 ? chord : NO_HIT;
     }
-    vec3 f = g + r * n0;
-    vec3 perpendicular = f - b * dir;
-    float discriminant = r * r - dot(perpendicular, perpendicular);
+    rvec3 f = g + r * n0;
+    rvec3 perpendicular = f - b * dir;
+    real discriminant = r * r - dot(perpendicular, perpendicular);
     if (discriminant < 0.0) return NO_HIT;
-    float c = dot(g, g) + 2.0 * r * dot(n0, g);
+    real c = dot(g, g) + 2.0 * r * dot(n0, g);
     if (abs(c / (length(f) + r)) <= ROUNDING * (length(origin) + length(anchorRadius.xyz) + length(g)))
         return b < 0.0 ? 0.0 : NO_HIT;
     return rootsToHit(b, 1.0, c, discriminant);

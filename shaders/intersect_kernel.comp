@@ -1,5 +1,6 @@
-// Test kernel: the renderer's float intersector (intersect.glsl) applied to a
-// list of cases, one per invocation; t (or the no-hit value) per case.
+// Test kernel: the renderer's intersector (intersect.glsl, float32 or, with
+// SNELL_FP64, double) applied to a list of cases, one per invocation; t (or the
+// no-hit value) per case, as the float pair hi + lo.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #include "shared_layout.h"
@@ -14,8 +15,21 @@ void main() {
     uint i = gl_GlobalInvocationID.x;
     if (i >= cases[0].count) return;
     IntersectCase c = cases[i];
-    float t = c.kind == SNELL_CASE_ELLIPSOID
-                  ? intersectEllipsoid(c.objectFromWorld, c.origin.xyz, c.direction.xyz, c.mode)
-                  : intersectTrueSphere(c.anchorRadius, c.normal.xyz, c.origin.xyz, c.direction.xyz, c.mode);
-    results[i] = vec4(t, 0.0, 0.0, 0.0);
+#ifdef SNELL_FP64
+    dvec3 origin = dvec3(c.origin.xyz) + dvec3(c.originLow.xyz);
+    dvec3 direction = dvec3(c.direction.xyz) + dvec3(c.directionLow.xyz);
+    dmat4 objectFromWorld = dmat4(c.objectFromWorld) + dmat4(c.objectFromWorldLow);
+    dvec4 anchorRadius = dvec4(c.anchorRadius) + dvec4(c.anchorRadiusLow);
+    dvec3 normal = dvec3(c.normal.xyz) + dvec3(c.normalLow.xyz);
+#else
+    vec3 origin = c.origin.xyz;
+    vec3 direction = c.direction.xyz;
+    mat4 objectFromWorld = c.objectFromWorld;
+    vec4 anchorRadius = c.anchorRadius;
+    vec3 normal = c.normal.xyz;
+#endif
+    real t = c.kind == SNELL_CASE_ELLIPSOID ? intersectEllipsoid(objectFromWorld, origin, direction, c.mode)
+                                            : intersectTrueSphere(anchorRadius, normal, origin, direction, c.mode);
+    float hi = float(t);
+    results[i] = vec4(hi, float(t - real(hi)), 0.0, 0.0);
 }

@@ -34,7 +34,16 @@ using uint = std::uint32_t;
 #define SNELL_BINDING_PIXEL_STATES 8
 #define SNELL_BINDING_RAY_STACK 9
 #define SNELL_BINDING_MEDIA_STACK 10
-#define SNELL_BINDING_COUNT 11
+#define SNELL_BINDING_COUNT_FP32 11
+// The fp64 shader (--precision fp64) reads scene values as float pairs hi + lo
+// (hi = float(v), lo = float(v - hi): 48 bits of the host's double): the hi
+// parts are the buffers above, the lo parts twin buffers of the same layout.
+#define SNELL_BINDING_FRAME_LOW 11
+#define SNELL_BINDING_SPHERES_LOW 12
+#define SNELL_BINDING_ELLIPSOIDS_LOW 13
+#define SNELL_BINDING_LIGHTS_LOW 14
+#define SNELL_BINDING_RAY_STACK_LOW 15
+#define SNELL_BINDING_COUNT 16
 
 // Specialization constants: compile only what a scene uses.
 #define SNELL_SPEC_USE_BVH 0

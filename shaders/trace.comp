@@ -1,4 +1,5 @@
-// snell's renderer: one pixel per invocation, SPEC §3–§5 in float32.
+// snell's renderer: one pixel per invocation, SPEC §3–§5 in float32, or in
+// double when compiled with SNELL_FP64 (precision.glsl; --precision fp64).
 // The path of one ray: camera (main) -> trace (explicit stack) -> closestHit /
 // intersectSphere -> shade (local Phong term, shadow rays) -> children pushed
 // on the stack. Its double-precision twin is host/reference/CpuRenderer.cpp;
@@ -41,6 +42,27 @@ layout(set = 0, binding = SNELL_BINDING_RAY_STACK, std430) buffer RayStackBlock 
 layout(set = 0, binding = SNELL_BINDING_MEDIA_STACK, std430) buffer MediaStackBlock { uint mediaStack[]; };
 layout(push_constant) uniform TileBlock { TileParams tile; };
 
+// Scene values as the shader computes with them. In fp64 a value is its float
+// pair hi + lo: the low parts live in twin buffers of the same layout.
+#ifdef SNELL_FP64
+layout(set = 0, binding = SNELL_BINDING_FRAME_LOW, std140) uniform FrameLowBlock { FrameParams frameLow; };
+layout(set = 0, binding = SNELL_BINDING_SPHERES_LOW, std430) readonly buffer SphereLowBlock { Sphere sphereLows[]; };
+layout(set = 0, binding = SNELL_BINDING_ELLIPSOIDS_LOW, std430) readonly buffer EllipsoidLowBlock {
+    Ellipsoid ellipsoidLows[];
+};
+layout(set = 0, binding = SNELL_BINDING_LIGHTS_LOW, std430) readonly buffer LightLowBlock { Light lightLows[]; };
+layout(set = 0, binding = SNELL_BINDING_RAY_STACK_LOW, std430) buffer RayStackLowBlock { PendingRay rayStackLow[]; };
+#define WIDE(hi, lo) (dvec4(hi) + dvec4(lo))
+#define WIDE_MATRIX(hi, lo) (dmat4(hi) + dmat4(lo))
+#else
+#define WIDE(hi, lo) (hi)
+#define WIDE_MATRIX(hi, lo) (hi)
+#endif
+rvec4 sphereAnchor(uint i) { return WIDE(spheres[i].anchorRadius, sphereLows[i].anchorRadius); }
+rvec3 sphereNormal(uint i) { return WIDE(spheres[i].normal, sphereLows[i].normal).xyz; }
+rmat4 ellipsoidMatrix(uint e) { return WIDE_MATRIX(ellipsoids[e].objectFromWorld, ellipsoidLows[e].objectFromWorld); }
+rvec3 lightPosition(uint j) { return WIDE(lights[j].position, lightLows[j].position).xyz; }
+
 const uint NONE = 0xffffffffu;
 
 uint countedRays[SNELL_RAY_COUNTER_COUNT];
@@ -58,50 +80,50 @@ void tick() {
 // Intersection: the maths is in intersect.glsl (shared with the test kernel);
 // here the sphere is fetched and the ray's relation to it decided.
 
-float intersectSphere(uint index, vec3 origin, vec3 dir, uint fromSphere, uint start) {
+real intersectSphere(uint index, rvec3 origin, rvec3 dir, uint fromSphere, uint start) {
     uint mode = index == fromSphere ? start : ELSEWHERE;
     if (mode == LEAVING) return NO_HIT;
-    Sphere s = spheres[index];
-    if (HAS_ELLIPSOIDS && s.ellipsoid != SNELL_NOT_ELLIPSOID)
-        return intersectEllipsoid(ellipsoids[s.ellipsoid].objectFromWorld, origin, dir, mode);
-    return intersectTrueSphere(s.anchorRadius, s.normal.xyz, origin, dir, mode);
+    uint ellipsoid = spheres[index].ellipsoid;
+    if (HAS_ELLIPSOIDS && ellipsoid != SNELL_NOT_ELLIPSOID)
+        return intersectEllipsoid(ellipsoidMatrix(ellipsoid), origin, dir, mode);
+    return intersectTrueSphere(sphereAnchor(index), sphereNormal(index), origin, dir, mode);
 }
 
 // Slab test against a node's box (stored rounded outwards), within [0, tMax].
-bool hitsBox(uint node, vec3 origin, vec3 inverseDir, float tMax) {
-    vec3 t0 = (nodes[node].lower.xyz - origin) * inverseDir;
-    vec3 t1 = (nodes[node].upper.xyz - origin) * inverseDir;
-    vec3 tNear = min(t0, t1);
-    vec3 tFar = max(t0, t1);
-    float enter = max(max(tNear.x, tNear.y), max(tNear.z, 0.0));
+bool hitsBox(uint node, rvec3 origin, rvec3 inverseDir, real tMax) {
+    rvec3 t0 = (rvec3(nodes[node].lower.xyz) - origin) * inverseDir;
+    rvec3 t1 = (rvec3(nodes[node].upper.xyz) - origin) * inverseDir;
+    rvec3 tNear = min(t0, t1);
+    rvec3 tFar = max(t0, t1);
+    real enter = max(max(tNear.x, tNear.y), max(tNear.z, 0.0));
     // Ize, "Robust BVH Ray Traversal" (JCGT 2013): widen the exit distance so
     // rounding never culls a box the ray touches.
-    float leave = min(min(tFar.x, tFar.y), min(tFar.z, tMax)) * 1.0000004;
+    real leave = min(min(tFar.x, tFar.y), min(tFar.z, tMax)) * (1.0 + 8.0 * UNIT_ROUNDOFF);
     return enter <= leave;
 }
 
-vec3 safeInverse(vec3 d) {
-    const float tiny = 1e-30;
-    return 1.0 / mix(d, vec3(tiny) * sign(d + vec3(1e-38)), lessThan(abs(d), vec3(tiny)));
+rvec3 safeInverse(rvec3 d) {
+    const real tiny = 1e-30;
+    return 1.0 / mix(d, rvec3(tiny) * sign(d + rvec3(1e-38)), lessThan(abs(d), rvec3(tiny)));
 }
 
 // SPEC §4.1: the closest hit with t > 0; returns the sphere index or NONE.
 // The BVH is walked without a stack (nodes in depth-first order with skip
 // links, see shared_layout.h): no per-invocation array, which matters on
 // lavapipe, where dynamically indexed private arrays go to scratch memory.
-uint closestHit(vec3 origin, vec3 dir, uint fromSphere, uint start, out float tHit) {
+uint closestHit(rvec3 origin, rvec3 dir, uint fromSphere, uint start, out real tHit) {
     tHit = NO_HIT;
     uint hit = NONE;
     if (!USE_BVH) {
         tick();
         for (uint i = 0u; i < frame.sphereCount; ++i) {
             tick();
-            float t = intersectSphere(i, origin, dir, fromSphere, start);
+            real t = intersectSphere(i, origin, dir, fromSphere, start);
             if (t < tHit) { tHit = t; hit = i; }
         }
         return hit;
     }
-    vec3 inverseDir = safeInverse(dir);
+    rvec3 inverseDir = safeInverse(dir);
     uint node = 0u;
     tick();
     while (node < frame.bvhNodeCount) {
@@ -119,7 +141,7 @@ uint closestHit(vec3 origin, vec3 dir, uint fromSphere, uint start, out float tH
         tick();
         for (uint i = first; i < first + count; ++i) {
             tick();
-            float t = intersectSphere(i, origin, dir, fromSphere, start);
+            real t = intersectSphere(i, origin, dir, fromSphere, start);
             if (t < tHit) { tHit = t; hit = i; }
         }
         node = nodes[node].skip;
@@ -128,7 +150,7 @@ uint closestHit(vec3 origin, vec3 dir, uint fromSphere, uint start, out float tH
 }
 
 // SPEC §4.3 visibility: does any surface cross the open segment (0, distance)?
-bool occluded(vec3 origin, vec3 dir, float distance, uint fromSphere, uint start) {
+bool occluded(rvec3 origin, rvec3 dir, real distance, uint fromSphere, uint start) {
     bool blocked = false;
     if (!USE_BVH) {
         tick();
@@ -138,7 +160,7 @@ bool occluded(vec3 origin, vec3 dir, float distance, uint fromSphere, uint start
         }
         return blocked;
     }
-    vec3 inverseDir = safeInverse(dir);
+    rvec3 inverseDir = safeInverse(dir);
     uint node = 0u;
     tick();
     while (node < frame.bvhNodeCount && !blocked) {
@@ -175,7 +197,7 @@ bool worthTracing(vec3 w) {
 }
 
 // Local Phong term with binary shadows (SPEC §4.3) at x with shading normal n.
-vec3 shade(Material m, vec3 x, vec3 n, vec3 v, uint hitSphere, bool fromOutside) {
+vec3 shade(Material m, rvec3 x, rvec3 n, rvec3 v, uint hitSphere, bool fromOutside) {
     vec3 local = frame.ambient.rgb * m.kd.rgb;
     if (HAS_LIGHTS) {
         // A shadow ray towards N's side enters the hit sphere only when N = −No.
@@ -183,14 +205,14 @@ vec3 shade(Material m, vec3 x, vec3 n, vec3 v, uint hitSphere, bool fromOutside)
         tick();
         for (uint j = 0u; j < frame.lightCount; ++j) {
             tick();
-            vec3 l = lights[j].position.xyz - x;
-            float distance = length(l);
+            rvec3 l = lightPosition(j) - x;
+            real distance = length(l);
             l /= distance;
-            float nl = dot(n, l);
+            float nl = float(dot(n, l));
             if (nl > 0.0) {
                 if (COUNT_RAYS) countedRays[SNELL_COUNTER_SHADOW]++;
                 if (!occluded(x, l, distance, hitSphere, start)) {
-                    float rv = dot(2.0 * nl * n - l, v);
+                    float rv = float(dot(2.0 * dot(n, l) * n - l, v));
                     float specular = rv > 0.0 ? pow(rv, m.kd.w) : 0.0;
                     local += lights[j].colour.rgb * (m.kd.rgb * nl + m.ks.rgb * specular);
                 }
@@ -204,8 +226,8 @@ vec3 shade(Material m, vec3 x, vec3 n, vec3 v, uint hitSphere, bool fromOutside)
 // reflected one, when a ray also refracts) goes to the pixel's stack in
 // device memory, and so does the current ray when the pixel suspends.
 struct Ray {
-    vec3 origin;
-    vec3 dir;
+    rvec3 origin;
+    rvec3 dir;
     vec3 weight;      // product of the ks/kt factors along its path
     uint depth;
     uint fromSphere;  // the sphere whose surface it starts on
@@ -218,8 +240,14 @@ float etaOfSphere(uint sphere) { return materials[spheres[sphere].material].kt.w
 
 void pushRay(uint pixel, inout PixelState state, Ray r) {
     uint slot = pixel * uint(RAY_STACK) + state.pending;
-    rayStack[slot] = PendingRay(vec4(r.origin, 0.0), vec4(r.dir, 0.0), vec4(r.weight, 0.0), r.depth, r.fromSphere,
-                                r.inward ? 1u : 0u, r.mediaCount);
+    vec4 origin = vec4(r.origin, 0.0);
+    vec4 dir = vec4(r.dir, 0.0);
+    rayStack[slot] = PendingRay(origin, dir, vec4(r.weight, 0.0), r.depth, r.fromSphere, r.inward ? 1u : 0u,
+                                r.mediaCount);
+#ifdef SNELL_FP64
+    rayStackLow[slot].origin = vec4(r.origin - dvec3(origin.xyz), 0.0);
+    rayStackLow[slot].direction = vec4(r.dir - dvec3(dir.xyz), 0.0);
+#endif
     tick();
     for (uint k = 0u; k < r.mediaCount; ++k) {
         tick();
@@ -237,7 +265,8 @@ Ray popRay(uint pixel, inout PixelState state) {
         tick();
         media[k] = mediaStack[slot * uint(MAX_MEDIA) + k];
     }
-    return Ray(p.origin.xyz, p.direction.xyz, p.weight.rgb, p.depth, p.fromSphere, p.inward != 0u, p.mediaCount);
+    return Ray(WIDE(p.origin, rayStackLow[slot].origin).xyz, WIDE(p.direction, rayStackLow[slot].direction).xyz,
+               p.weight.rgb, p.depth, p.fromSphere, p.inward != 0u, p.mediaCount);
 }
 
 // Trace ray r: closest hit, local term, children. On return r is the child
@@ -248,35 +277,36 @@ void traceRay(uint pixel, inout PixelState state, inout Ray r, out bool hasRay, 
     vec3 weight = r.weight;
     if (AMPLIFYING) weight = mix(weight, vec3(0.0), greaterThanEqual(state.sum.rgb, vec3(saturation)));
     if (!worthTracing(weight)) return;
-    vec3 o = r.origin;
-    vec3 d = r.dir;
+    rvec3 o = r.origin;
+    rvec3 d = r.dir;
 
     // 1. Closest hit.
-    float t;
+    real t;
     uint hitSphere = closestHit(o, d, r.fromSphere, r.inward ? ENTERING : LEAVING, t);
     if (hitSphere == NONE) {
         state.sum.rgb += weight * frame.background.rgb;
         return;
     }
-    Sphere s = spheres[hitSphere];
-    Material m = materials[s.material];
+    uint ellipsoid = spheres[hitSphere].ellipsoid;
+    Material m = materials[spheres[hitSphere].material];
 
     // 2. Hit point o + t d, not re-projected onto the surface: re-projecting
     // (centre + r n̂, or normalising the object-space point) rounds at the
     // scale of the centre or of the largest semi-axis, which for a big floor
     // sphere near the camera is 100× the error of o + t d. Self-intersection
     // needs no point exactly on the surface (see intersectSphere).
-    vec3 x = o + t * d;
-    vec3 outward;
-    if (HAS_ELLIPSOIDS && s.ellipsoid != SNELL_NOT_ELLIPSOID) {
-        mat4 objectFromWorld = ellipsoids[s.ellipsoid].objectFromWorld;
-        vec3 p = (objectFromWorld * vec4(o, 1.0)).xyz + t * (mat3(objectFromWorld) * d);
-        outward = normalize(transpose(mat3(objectFromWorld)) * p);
+    rvec3 x = o + t * d;
+    rvec3 outward;
+    if (HAS_ELLIPSOIDS && ellipsoid != SNELL_NOT_ELLIPSOID) {
+        rmat4 objectFromWorld = ellipsoidMatrix(ellipsoid);
+        rvec3 p = (objectFromWorld * rvec4(o, 1.0)).xyz + t * (rmat3(objectFromWorld) * d);
+        outward = normalize(transpose(rmat3(objectFromWorld)) * p);
     } else {
-        outward = normalize(o - s.anchorRadius.xyz + t * d + s.anchorRadius.w * s.normal.xyz);
+        rvec4 anchor = sphereAnchor(hitSphere);
+        outward = normalize(o - anchor.xyz + t * d + anchor.w * sphereNormal(hitSphere));
     }
     bool fromOutside = dot(d, outward) < 0.0;
-    vec3 n = fromOutside ? outward : -outward;
+    rvec3 n = fromOutside ? outward : -outward;
 
     // 3. Local term.
     state.sum.rgb += weight * shade(m, x, n, -d, hitSphere, fromOutside);
@@ -285,12 +315,12 @@ void traceRay(uint pixel, inout PixelState state, inout Ray r, out bool hasRay, 
     // 4. Reflection (keeps the medium stack) and 5. refraction.
     vec3 reflectedWeight = HAS_REFLECTION ? weight * m.ks.rgb : vec3(0.0);
     bool refracts = false;
-    vec3 refracted = vec3(0.0);
+    rvec3 refracted = rvec3(0.0);
     vec3 transmittedWeight = vec3(0.0);
     uint removeAt = r.mediaCount;  // leaving: where this sphere is in the stack
     if (HAS_REFRACTION && max(m.kt.r, max(m.kt.g, m.kt.b)) > 0.0) {
         transmittedWeight = weight * m.kt.rgb;
-        float etaI, etaT;
+        real etaI, etaT;
         if (fromOutside) {
             // Entering: from the current medium into this sphere.
             etaI = r.mediaCount == 0u ? frame.background.w : etaOfSphere(media[r.mediaCount - 1u]);
@@ -313,9 +343,9 @@ void traceRay(uint pixel, inout PixelState state, inout Ray r, out bool hasRay, 
             etaT = innermost == r.mediaCount ? frame.background.w : etaOfSphere(media[innermost]);
         }
         // Snell's law, SPEC §4.5.
-        float eta = etaI / etaT;
-        float c = -dot(n, d);
-        float k = 1.0 - eta * eta * (1.0 - c * c);
+        real eta = etaI / etaT;
+        real c = -dot(n, d);
+        real k = 1.0 - eta * eta * (1.0 - c * c);
         if (k < 0.0) {
             // Total internal reflection is the reflected ray in the same medium:
             // one ray carries both weights.
@@ -379,7 +409,7 @@ void main() {
     // SPEC §3: s×s rays through (i + (a+½)/s, j + (b+½)/s); mean, then clamp on output.
     uint s = frame.supersample;
     uint samples = s * s;
-    float saturation = AMPLIFYING ? float(samples) : NO_HIT;
+    float saturation = AMPLIFYING ? float(samples) : 3.0e38;
     uvec2 imagePixel = local + uvec2(tile.originX, tile.originY);
 
     Ray ray;
@@ -404,10 +434,14 @@ void main() {
                 } else {
                     // Camera: the next primary ray of this pixel.
                     uvec2 ab = uvec2(state.started % s, state.started / s);
-                    vec2 p = vec2(imagePixel) + (vec2(ab) + 0.5) / float(s);
-                    vec3 dir = normalize(frame.cornerDir.xyz + p.x * frame.pixelRight.xyz + p.y * frame.pixelDown.xyz);
+                    rvec2 p = rvec2(imagePixel) + (rvec2(ab) + 0.5) / real(s);
+                    rvec3 corner = WIDE(frame.cornerDir, frameLow.cornerDir).xyz;
+                    rvec3 right = WIDE(frame.pixelRight, frameLow.pixelRight).xyz;
+                    rvec3 down = WIDE(frame.pixelDown, frameLow.pixelDown).xyz;
+                    rvec3 dir = normalize(corner + p.x * right + p.y * down);
                     // It starts at distance D along its way, before any geometry.
-                    vec3 start = frame.primaryStart.xyz + frame.primaryStart.w * dir;
+                    rvec4 primaryStart = WIDE(frame.primaryStart, frameLow.primaryStart);
+                    rvec3 start = primaryStart.xyz + primaryStart.w * dir;
                     ray = Ray(start, dir, vec3(1.0), 0u, NONE, false, 0u);
                     hasRay = true;
                     state.started++;

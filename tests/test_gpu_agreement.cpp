@@ -1,6 +1,6 @@
 // GPU (float32 compute shader, default settings) against the CPU reference
 // (double, converged settings) on every scene in scenes/ and in the course's
-// scene files. Runs on lavapipe in CI and is never skipped: no Vulkan device is
+// scene files, and the fp64 shader (--precision fp64) on the hard cases. Runs on lavapipe in CI and is never skipped: no Vulkan device is
 // a failure. On failure the GPU image, the reference and a difference image are
 // written to build/test-artifacts/ and named in the message.
 #include <chrono>
@@ -38,9 +38,12 @@ struct Case {
     // Issue 4's speckle rule holds for snell's own scenes; the course files'
     // speckles (chaotic multi-bounce pixels in becker-1n) are reported only.
     bool noSpeckles = true;
+    snell::gpu::Precision precision = snell::gpu::Precision::Fp32;
 };
 
-void PrintTo(const Case& c, std::ostream* os) { *os << c.path; }
+void PrintTo(const Case& c, std::ostream* os) {
+    *os << c.path << (c.precision == snell::gpu::Precision::Fp64 ? " (fp64)" : "");
+}
 
 std::vector<Case> allCases() {
     std::vector<Case> cases;
@@ -60,6 +63,10 @@ std::vector<Case> allCases() {
         if (name == "becker-SphereFlake2") c.referenceDepth = 20;
         c.noSpeckles = p.find("/course-scenes/") == std::string::npos;
         cases.push_back(c);
+        if (p.find("/scenes/hard/") != std::string::npos) {
+            c.precision = snell::gpu::Precision::Fp64;
+            cases.push_back(c);
+        }
     }
     return cases;
 }
@@ -68,7 +75,8 @@ snell::vk::Context& context() { return snell::testing::gpuContext(); }
 
 std::string testName(const testing::TestParamInfo<Case>& info) {
     std::string n = fs::path(info.param.path).parent_path().filename().string() + "_" +
-                    fs::path(info.param.path).stem().string();
+                    fs::path(info.param.path).stem().string() +
+                    (info.param.precision == snell::gpu::Precision::Fp64 ? "_fp64" : "");
     for (char& c : n)
         if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
     return n;
@@ -132,7 +140,7 @@ TEST_P(GpuAgreement, MatchesCpuReference) {
     request.trace = snell::kDefaultSettings;
 
     const std::uint32_t messagesBefore = context().validationMessages();
-    snell::ComputeRenderer gpuRenderer(context(), scene, request.camera);
+    snell::ComputeRenderer gpuRenderer(context(), scene, request.camera, c.precision);
     const snell::GpuRenderResult gpu = gpuRenderer.render(request, false);
     EXPECT_EQ(context().validationMessages(), messagesBefore) << "the Vulkan validation layer reported messages";
 
@@ -191,9 +199,10 @@ TEST_P(GpuAgreement, MatchesCpuReference) {
         artifacts = "\nimages: " + base + "-gpu.png, " + base + "-reference.png, " + base + "-diff.png";
     }
     EXPECT_EQ(m.nonFinite, 0u) << artifacts;
-    if (c.noSpeckles)
+    if (c.noSpeckles) {
         EXPECT_EQ(speckles, 0u) << "isolated pixels off by more than 8/255 (left out: " << m.speckles - speckles
-                            << " ill-conditioned or unconverged)" << artifacts;
+                                << " ill-conditioned or unconverged)" << artifacts;
+    }
     EXPECT_LE(m.meanAbsError, kMaxMeanError) << artifacts;
     EXPECT_LE(badFraction, kMaxBadFraction) << "bad pixels " << m.badPixels << ", ill-conditioned left out "
                                             << illConditioned << ", unconverged left out " << unconverged << artifacts;

@@ -56,6 +56,7 @@ struct RenderOptions {
     std::optional<double> minWeight;
     std::optional<int> supersample;
     int gpu = -1;
+    std::string precision = "fp32";
     bool stats = false;
     bool quiet = false;
     bool validation = false;
@@ -140,7 +141,7 @@ int runRender(const RenderOptions& o) {
         const std::string settings =
             "size " + std::to_string(size) + ", supersample " + std::to_string(request.supersample) + ", depth " +
             std::to_string(request.trace.maxDepth) + ", min-weight " + std::to_string(request.trace.minWeight) +
-            ", " + (o.cpu ? "CPU reference" : "GPU");
+            ", " + (o.cpu ? "CPU reference" : "GPU " + o.precision);
         writer = snell::ImageWriter::open(output, size, size,
                                           {{"Title", scene.name},
                                            {"Source", o.scene},
@@ -186,7 +187,9 @@ int runRender(const RenderOptions& o) {
             options.validation = o.validation;
             snell::vk::Context context(options);
             device = context.deviceName();
-            snell::ComputeRenderer renderer(context, scene, request.camera);
+            snell::ComputeRenderer renderer(
+                context, scene, request.camera,
+                o.precision == "fp64" ? snell::gpu::Precision::Fp64 : snell::gpu::Precision::Fp32);
             uploadMs = renderer.uploadMs();
             snell::GpuRenderResult r = renderer.render(request, o.stats);
             rays = r.rays;
@@ -231,6 +234,7 @@ int runRender(const RenderOptions& o) {
         j.precision(6);
         j << std::fixed << "{\"scene\": " << jsonString(o.scene) << ", \"output\": " << jsonString(output)
           << ", \"backend\": \"" << (o.cpu ? "cpu" : "gpu") << "\", \"device\": " << jsonString(device)
+          << ", \"precision\": \"" << (o.cpu ? "fp64-reference" : o.precision) << "\""
           << ", \"width\": " << request.width << ", \"height\": " << request.height
           << ", \"supersample\": " << request.supersample << ", \"max_depth\": " << request.trace.maxDepth
           << ", \"min_weight\": " << request.trace.minWeight << ", \"spheres\": " << scene.spheres.size()
@@ -315,6 +319,9 @@ int main(int argc, char** argv) {
         ->check(CLI::Range(1, snell::ParseLimits::kMaxSupersample));
     render->add_option("--gpu", ro.gpu, "Vulkan device index (see 'snell devices'; default: $SNELL_GPU, else the best)")
         ->envname("SNELL_GPU")->check(CLI::NonNegativeNumber);
+    render->add_option("--precision", ro.precision,
+                       "GPU arithmetic for geometry: fp32 (default) or fp64 (needs shaderFloat64; slower)")
+        ->check(CLI::IsMember({"fp32", "fp64"}));
     render->add_flag("--stats", ro.stats, "Print timings and ray counts as one JSON object on the last line of stdout");
     render->add_flag("-q,--quiet", ro.quiet, "No warnings or progress on stderr");
     render->add_flag("--validation", ro.validation, "Enable the Khronos validation layer; any message fails the render")

@@ -6,7 +6,8 @@
 #include <cmath>
 #include <cstring>
 
-#include "trace_comp_spv.h"  // generated at build time from shaders/trace.comp
+#include "trace_comp_spv.h"       // generated at build time from shaders/trace.comp
+#include "trace_fp64_comp_spv.h"  // the same, compiled with SNELL_FP64
 
 namespace snell {
 
@@ -35,15 +36,22 @@ struct ComputeRenderer::Pipeline {
     VkCommandBuffer commands = VK_NULL_HANDLE;
     VkFence fence = VK_NULL_HANDLE;
     vk::Buffer frame, counters, readback, pixelStates, rayStack, mediaStack;
+    vk::Buffer frameLow, rayStackLow;  // fp64 only
     std::uint32_t rayStackDepth = 1;  // the RAY_STACK specialisation
     std::uint32_t maxMedia = 1;       // the MAX_MEDIA specialisation
+    std::uint32_t bindingCount = SNELL_BINDING_COUNT_FP32;
     vk::StorageImage image;
 };
 
-ComputeRenderer::ComputeRenderer(vk::Context& context, const Scene& scene, const Camera& camera)
+ComputeRenderer::ComputeRenderer(vk::Context& context, const Scene& scene, const Camera& camera,
+                                 gpu::Precision precision)
     : context_(context), scene_(scene) {
+    if (precision == gpu::Precision::Fp64 && !context.float64Supported())
+        throw vk::VulkanError("--precision fp64 needs shader doubles (the shaderFloat64 feature), which " +
+                              std::string(context.properties().deviceName) +
+                              " lacks; use --precision fp32, or another device (--gpu; lavapipe has them)");
     const auto start = Clock::now();
-    layout_ = gpu::buildGpuScene(scene, camera);
+    layout_ = gpu::buildGpuScene(scene, camera, precision);
     const VkDeviceSize limit = context.properties().limits.maxStorageBufferRange;
     auto upload = [&](const auto& v, const char* what) {
         const VkDeviceSize bytes = v.size() * sizeof(v[0]);
@@ -59,21 +67,32 @@ ComputeRenderer::ComputeRenderer(vk::Context& context, const Scene& scene, const
         materials_ = upload(layout_.materials, "materials");
         lights_ = upload(layout_.lights, "lights");
         nodes_ = upload(layout_.nodes, "BVH nodes");
+        if (precision == gpu::Precision::Fp64) {
+            sphereLows_ = upload(layout_.sphereLows, "spheres");
+            ellipsoidLows_ = upload(layout_.ellipsoidLows, "ellipsoids");
+            lightLows_ = upload(layout_.lightLows, "lights");
+        }
     } catch (...) {
-        for (vk::Buffer* b : {&spheres_, &ellipsoids_, &materials_, &lights_, &nodes_}) context_.destroy(*b);
+        destroyBuffers();
         throw;
     }
     uploadMs_ = msSince(start);
 }
 
-ComputeRenderer::~ComputeRenderer() {
-    for (vk::Buffer* b : {&spheres_, &ellipsoids_, &materials_, &lights_, &nodes_}) context_.destroy(*b);
+ComputeRenderer::~ComputeRenderer() { destroyBuffers(); }
+
+void ComputeRenderer::destroyBuffers() {
+    for (vk::Buffer* b :
+         {&spheres_, &ellipsoids_, &materials_, &lights_, &nodes_, &sphereLows_, &ellipsoidLows_, &lightLows_})
+        context_.destroy(*b);
 }
 
 void ComputeRenderer::createPipeline(const RenderRequest& request, bool countRays, Pipeline& p) {
     VkDevice device = context_.device();
+    const bool wide = layout_.precision == gpu::Precision::Fp64;
+    p.bindingCount = wide ? SNELL_BINDING_COUNT : SNELL_BINDING_COUNT_FP32;
     std::array<VkDescriptorSetLayoutBinding, SNELL_BINDING_COUNT> bindings{};
-    for (std::uint32_t i = 0; i < bindings.size(); ++i) {
+    for (std::uint32_t i = 0; i < p.bindingCount; ++i) {
         bindings[i].binding = i;
         bindings[i].descriptorCount = 1;
         bindings[i].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
@@ -81,8 +100,9 @@ void ComputeRenderer::createPipeline(const RenderRequest& request, bool countRay
     }
     bindings[SNELL_BINDING_OUTPUT_IMAGE].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
     bindings[SNELL_BINDING_FRAME].descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
+    bindings[SNELL_BINDING_FRAME_LOW].descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
     VkDescriptorSetLayoutCreateInfo setInfo{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
-    setInfo.bindingCount = static_cast<std::uint32_t>(bindings.size());
+    setInfo.bindingCount = p.bindingCount;
     setInfo.pBindings = bindings.data();
     check(vkCreateDescriptorSetLayout(device, &setInfo, nullptr, &p.setLayout), "vkCreateDescriptorSetLayout");
 
@@ -95,8 +115,8 @@ void ComputeRenderer::createPipeline(const RenderRequest& request, bool countRay
     check(vkCreatePipelineLayout(device, &layoutInfo, nullptr, &p.layout), "vkCreatePipelineLayout");
 
     VkShaderModuleCreateInfo moduleInfo{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
-    moduleInfo.codeSize = sizeof(snell_trace_comp_spv);
-    moduleInfo.pCode = snell_trace_comp_spv;
+    moduleInfo.codeSize = wide ? sizeof(snell_trace_fp64_comp_spv) : sizeof(snell_trace_comp_spv);
+    moduleInfo.pCode = wide ? snell_trace_fp64_comp_spv : snell_trace_comp_spv;
     check(vkCreateShaderModule(device, &moduleInfo, nullptr, &p.module), "vkCreateShaderModule");
 
     // Specialise to the scene: only what it uses is compiled.
@@ -132,9 +152,10 @@ void ComputeRenderer::createPipeline(const RenderRequest& request, bool countRay
     check(vkCreateComputePipelines(device, VK_NULL_HANDLE, 1, &pipelineInfo, nullptr, &p.pipeline),
           "vkCreateComputePipelines");
 
+    const std::uint32_t uniformBuffers = wide ? 2 : 1;
     std::array<VkDescriptorPoolSize, 3> sizes{{{VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1},
-                                               {VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1},
-                                               {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, SNELL_BINDING_COUNT - 2}}};
+                                               {VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, uniformBuffers},
+                                               {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, p.bindingCount - 1 - uniformBuffers}}};
     VkDescriptorPoolCreateInfo poolInfo{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
     poolInfo.maxSets = 1;
     poolInfo.poolSizeCount = static_cast<std::uint32_t>(sizes.size());
@@ -182,6 +203,8 @@ void ComputeRenderer::destroyPipeline(Pipeline& p) {
     context_.destroy(p.pixelStates);
     context_.destroy(p.rayStack);
     context_.destroy(p.mediaStack);
+    context_.destroy(p.frameLow);
+    context_.destroy(p.rayStackLow);
     context_.destroy(p.image);
 }
 
@@ -228,8 +251,10 @@ GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool count
         // Tiles: square, a multiple of the workgroup, as large as the memory for
         // the pixels' ray stacks allows (at most 1024²).
         const int s = std::max(1, request.supersample);
-        const VkDeviceSize bytesPerPixel = sizeof(gpu::PixelState) +
-                                           VkDeviceSize(p.rayStackDepth) * (sizeof(gpu::PendingRay) + p.maxMedia * 4);
+        const bool wide = layout_.precision == gpu::Precision::Fp64;  // a low part per pending ray too
+        const VkDeviceSize bytesPerPixel =
+            sizeof(gpu::PixelState) +
+            VkDeviceSize(p.rayStackDepth) * ((wide ? 2 : 1) * sizeof(gpu::PendingRay) + p.maxMedia * 4);
         const VkDeviceSize limit = context_.properties().limits.maxStorageBufferRange;
         const VkDeviceSize maxPixels = std::min(kTileStateBudget, limit) / bytesPerPixel;
         const int tileSide = std::clamp(static_cast<int>(std::sqrt(double(maxPixels))) / 8 * 8, 8, 1024);
@@ -237,15 +262,21 @@ GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool count
         const int tileH = std::min(tileSide, request.height);
         const VkDeviceSize tilePixels = VkDeviceSize(tileW) * tileH;
 
+        gpu::FrameParams frameLow{};
         const gpu::FrameParams frame = gpu::makeFrameParams(scene_, layout_, request.camera, request.width,
                                                             request.height, s, request.trace.maxDepth,
-                                                            request.trace.minWeight);
+                                                            request.trace.minWeight, &frameLow);
         p.frame = context_.createBufferWithData(&frame, sizeof frame, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
         p.counters = context_.createBuffer(SNELL_COUNTER_COUNT * sizeof(std::uint32_t), kStorage, true);
         p.pixelStates = context_.createBuffer(tilePixels * sizeof(gpu::PixelState),
                                               kStorage | VK_BUFFER_USAGE_TRANSFER_DST_BIT, false);
         p.rayStack = context_.createBuffer(tilePixels * p.rayStackDepth * sizeof(gpu::PendingRay), kStorage, false);
         p.mediaStack = context_.createBuffer(tilePixels * p.rayStackDepth * p.maxMedia * 4, kStorage, false);
+        if (wide) {
+            p.frameLow = context_.createBufferWithData(&frameLow, sizeof frameLow, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
+            p.rayStackLow = context_.createBuffer(tilePixels * p.rayStackDepth * sizeof(gpu::PendingRay), kStorage,
+                                                  false);
+        }
         p.image = context_.createStorageImage(tileW, tileH, VK_FORMAT_R32G32B32A32_SFLOAT);
         p.readback = context_.createBuffer(VkDeviceSize(tileW) * tileH * 4 * sizeof(float),
                                            VK_BUFFER_USAGE_TRANSFER_DST_BIT, true);
@@ -263,8 +294,13 @@ GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool count
         buffers[SNELL_BINDING_PIXEL_STATES] = &p.pixelStates;
         buffers[SNELL_BINDING_RAY_STACK] = &p.rayStack;
         buffers[SNELL_BINDING_MEDIA_STACK] = &p.mediaStack;
+        buffers[SNELL_BINDING_FRAME_LOW] = &p.frameLow;
+        buffers[SNELL_BINDING_SPHERES_LOW] = &sphereLows_;
+        buffers[SNELL_BINDING_ELLIPSOIDS_LOW] = &ellipsoidLows_;
+        buffers[SNELL_BINDING_LIGHTS_LOW] = &lightLows_;
+        buffers[SNELL_BINDING_RAY_STACK_LOW] = &p.rayStackLow;
         std::array<VkWriteDescriptorSet, SNELL_BINDING_COUNT> writes{};
-        for (std::uint32_t i = 0; i < SNELL_BINDING_COUNT; ++i) {
+        for (std::uint32_t i = 0; i < p.bindingCount; ++i) {
             writes[i] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
             writes[i].dstSet = p.set;
             writes[i].dstBinding = i;
@@ -274,12 +310,13 @@ GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool count
                 writes[i].pImageInfo = &imageInfo;
             } else {
                 bufferInfo[i] = {buffers[i]->buffer, 0, VK_WHOLE_SIZE};
-                writes[i].descriptorType = i == SNELL_BINDING_FRAME ? VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER
-                                                                     : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+                writes[i].descriptorType = (i == SNELL_BINDING_FRAME || i == SNELL_BINDING_FRAME_LOW)
+                                               ? VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER
+                                               : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
                 writes[i].pBufferInfo = &bufferInfo[i];
             }
         }
-        vkUpdateDescriptorSets(device, SNELL_BINDING_COUNT, writes.data(), 0, nullptr);
+        vkUpdateDescriptorSets(device, p.bindingCount, writes.data(), 0, nullptr);
 
         // Record, submit and wait for one command buffer.
         double hostRenderMs = 0.0, gpuRenderMs = 0.0;

@@ -26,7 +26,9 @@ struct GpuRenderResult {
 class ComputeRenderer {
 public:
     // Uploads the scene; `camera.eye` becomes the GPU's coordinate origin.
-    ComputeRenderer(vk::Context& context, const Scene& scene, const Camera& camera);
+    // Fp64 needs the device's shaderFloat64 feature (else vk::VulkanError).
+    ComputeRenderer(vk::Context& context, const Scene& scene, const Camera& camera,
+                    gpu::Precision precision = gpu::Precision::Fp32);
     ~ComputeRenderer();
     ComputeRenderer(const ComputeRenderer&) = delete;
     ComputeRenderer& operator=(const ComputeRenderer&) = delete;
@@ -41,11 +43,13 @@ private:
     struct Pipeline;
     void createPipeline(const RenderRequest& request, bool countRays, Pipeline& pipeline);
     void destroyPipeline(Pipeline& pipeline);
+    void destroyBuffers();
 
     vk::Context& context_;
     const Scene& scene_;
     gpu::GpuScene layout_;
     vk::Buffer spheres_, ellipsoids_, materials_, lights_, nodes_;
+    vk::Buffer sphereLows_, ellipsoidLows_, lightLows_;  // fp64 only
     double uploadMs_ = 0.0;
 };
 

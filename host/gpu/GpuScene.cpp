@@ -13,6 +13,17 @@ vec4 toVec4(const snell::dvec3& v, double w) {
     return vec4(static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z), static_cast<float>(w));
 }
 
+// v and w as float pairs: hi gets the rounded values, lo what rounding lost.
+void splitVec4(const snell::dvec3& v, double w, vec4& hi, vec4& lo) {
+    for (int k = 0; k < 3; ++k) splitDouble(v[k], hi[k], lo[k]);
+    splitDouble(w, hi.w, lo.w);
+}
+
+void splitMat4(const snell::dmat4& m, mat4& hi, mat4& lo) {
+    for (int c = 0; c < 4; ++c)
+        for (int r = 0; r < 4; ++r) splitDouble(m[c][r], hi[c][r], lo[c][r]);
+}
+
 // Round a box outwards to float so it still contains the double box.
 void outwardBox(const snell::Aabb& box, const snell::dvec3& eye, vec4& lower, vec4& upper) {
     for (int k = 0; k < 3; ++k) {
@@ -28,6 +39,11 @@ void outwardBox(const snell::Aabb& box, const snell::dvec3& eye, vec4& lower, ve
 }
 
 }  // namespace
+
+void splitDouble(double v, float& hi, float& lo) {
+    hi = static_cast<float>(v);
+    lo = std::isfinite(hi) ? static_cast<float>(v - static_cast<double>(hi)) : 0.0f;
+}
 
 double primaryStartDistance(const snell::Scene& scene, const snell::dvec3& eye) {
     // The nearest any sphere's bounding sphere comes to the eye, less a margin
@@ -47,8 +63,10 @@ double primaryStartDistance(const snell::Scene& scene, const snell::dvec3& eye) 
     return std::max(0.0, nearest - margin);
 }
 
-GpuScene buildGpuScene(const snell::Scene& scene, const snell::Camera& camera) {
+GpuScene buildGpuScene(const snell::Scene& scene, const snell::Camera& camera, Precision precision) {
     GpuScene out;
+    out.precision = precision;
+    const bool wide = precision == Precision::Fp64;
     out.eye = camera.eye;
     // The GPU's coordinate origin: where the central primary ray starts.
     out.primaryStart = primaryStartDistance(scene, camera.eye);
@@ -103,9 +121,10 @@ GpuScene buildGpuScene(const snell::Scene& scene, const snell::Camera& camera) {
     }
 
     out.spheres.reserve(scene.spheres.size());
+    if (wide) out.sphereLows.reserve(scene.spheres.size());
     for (std::uint32_t index : order) {
         const snell::Sphere& s = scene.spheres[index];
-        Sphere g{};
+        Sphere g{}, low{};
         g.material = s.material;
         g.ellipsoid = SNELL_NOT_ELLIPSOID;
         const snell::dvec3 centre = s.centre - eye;
@@ -113,34 +132,43 @@ GpuScene buildGpuScene(const snell::Scene& scene, const snell::Camera& camera) {
             // The anchor: the surface point nearest the origin, and its normal.
             const double distance = glm::length(centre);
             const snell::dvec3 n0 = distance > 0.0 ? -centre / distance : snell::dvec3(0.0, 0.0, 1.0);
-            g.anchorRadius = toVec4(centre + s.radius * n0, s.radius);
-            g.normal = toVec4(n0, 0.0);
+            splitVec4(centre + s.radius * n0, s.radius, g.anchorRadius, low.anchorRadius);
+            splitVec4(n0, 0.0, g.normal, low.normal);
         } else {
-            g.anchorRadius = toVec4(centre, s.radius);
+            splitVec4(centre, s.radius, g.anchorRadius, low.anchorRadius);
             g.ellipsoid = static_cast<uint>(out.ellipsoids.size());
-            Ellipsoid e;
-            e.objectFromWorld = mat4(s.objectFromWorld * worldFromCamera);
+            Ellipsoid e, eLow;
+            splitMat4(s.objectFromWorld * worldFromCamera, e.objectFromWorld, eLow.objectFromWorld);
             out.ellipsoids.push_back(e);
+            if (wide) out.ellipsoidLows.push_back(eLow);
         }
         if (scene.materials[s.material].refracts()) ++out.refractiveSpheres;
         out.spheres.push_back(g);
+        if (wide) out.sphereLows.push_back(low);
     }
     for (const snell::Material& m : scene.materials) {
         out.materials.push_back({toVec4(m.kd, m.phong), toVec4(m.ks, 0.0), toVec4(m.kt, m.eta)});
         out.amplifying |= m.amplifies();
     }
-    for (const snell::Light& l : scene.lights)
-        out.lights.push_back({toVec4(l.position - eye, 1.0), toVec4(l.colour, 0.0)});
+    for (const snell::Light& l : scene.lights) {
+        Light light{}, low{};
+        splitVec4(l.position - eye, 1.0, light.position, low.position);
+        light.colour = toVec4(l.colour, 0.0);
+        out.lights.push_back(light);
+        if (wide) out.lightLows.push_back(low);
+    }
     return out;
 }
 
 FrameParams makeFrameParams(const snell::Scene& scene, const GpuScene& gpuScene, const snell::Camera& camera,
-                            int width, int height, int supersample, int maxDepth, double minWeight) {
-    FrameParams f{};
-    f.primaryStart = toVec4(camera.eye - gpuScene.origin, gpuScene.primaryStart);
-    f.cornerDir = toVec4(camera.cornerDir, 0.0);
-    f.pixelRight = toVec4(camera.pixelRight, 0.0);
-    f.pixelDown = toVec4(camera.pixelDown, 0.0);
+                            int width, int height, int supersample, int maxDepth, double minWeight,
+                            FrameParams* lowParts) {
+    FrameParams f{}, low{};
+    splitVec4(camera.eye - gpuScene.origin, gpuScene.primaryStart, f.primaryStart, low.primaryStart);
+    splitVec4(camera.cornerDir, 0.0, f.cornerDir, low.cornerDir);
+    splitVec4(camera.pixelRight, 0.0, f.pixelRight, low.pixelRight);
+    splitVec4(camera.pixelDown, 0.0, f.pixelDown, low.pixelDown);
+    if (lowParts) *lowParts = low;
     f.background = toVec4(scene.background, snell::kAirEta);
     f.ambient = toVec4(scene.ambient, minWeight);
     f.imageWidth = static_cast<uint>(width);

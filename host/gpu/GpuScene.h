@@ -27,6 +27,9 @@ static_assert(sizeof(TileParams) == 16);
 static_assert(sizeof(PixelState) == 32 && offsetof(PixelState, started) == 16);
 static_assert(sizeof(PendingRay) == 64 && offsetof(PendingRay, depth) == 48 && offsetof(PendingRay, mediaCount) == 60);
 
+// The shader's working precision for geometry (shaders/precision.glsl).
+enum class Precision { Fp32, Fp64 };
+
 // Spheres above this count are traversed through the BVH; fewer are tested in a loop.
 inline constexpr std::size_t kBvhThreshold = 8;
 
@@ -36,6 +39,12 @@ struct GpuScene {
     std::vector<Material> materials;
     std::vector<Light> lights;
     std::vector<BvhNode> nodes;  // empty when no BVH is used
+    // Fp64 only (else empty): the low parts of the float pairs hi + lo, in
+    // the same layout (shared_layout.h); their non-geometric members are 0.
+    std::vector<Sphere> sphereLows;
+    std::vector<Ellipsoid> ellipsoidLows;
+    std::vector<Light> lightLows;
+    Precision precision = Precision::Fp32;
     std::size_t refractiveSpheres = 0;
     bool amplifying = false;
     snell::dvec3 eye{0.0};       // the camera's eye
@@ -45,13 +54,19 @@ struct GpuScene {
     double bvhBuildMs = 0.0;
 };
 
-GpuScene buildGpuScene(const snell::Scene& scene, const snell::Camera& camera);
+GpuScene buildGpuScene(const snell::Scene& scene, const snell::Camera& camera,
+                       Precision precision = Precision::Fp32);
 
 // How far primary rays from `eye` can go before they could meet any sphere.
 double primaryStartDistance(const snell::Scene& scene, const snell::dvec3& eye);
 
-// The frame parameters of one render (camera relative to camera.eye).
+// The frame parameters of one render (camera relative to camera.eye); with
+// `lowParts`, also the low parts of its float pairs (for the fp64 shader).
 FrameParams makeFrameParams(const snell::Scene& scene, const GpuScene& gpuScene, const snell::Camera& camera,
-                            int width, int height, int supersample, int maxDepth, double minWeight);
+                            int width, int height, int supersample, int maxDepth, double minWeight,
+                            FrameParams* lowParts = nullptr);
+
+// A double as the float pair hi + lo: hi = float(v), lo = float(v − hi).
+void splitDouble(double v, float& hi, float& lo);
 
 }  // namespace snell::gpu
