@@ -72,5 +72,22 @@ wait $pid; status=$?
 [ $status -eq 130 ] && [ ! -e "$work/interrupted.png" ] && ! ls "$work" | grep -q "interrupted.png.tmp" && ok ||
   bad "interrupted render (status $status): $(ls "$work")"
 
+# A GPU that fails mid-render (simulated by the SNELL_INJECT_FAULT hook): the
+# device is lost after the first band of rows has been streamed, or memory runs
+# out while the render allocates its tiles. Status 1, a message saying what
+# happened, the existing output untouched, no temporary left; the validation
+# layer sees the cleanup and must stay silent.
+for fault in device-lost:20 out-of-device-memory:9; do
+  echo "precious" >"$work/fault.png"
+  SNELL_INJECT_FAULT=$fault SNELL_VALIDATION=1 "$SNELL" render "$SCENES/showcase.scn" --size 600 -o "$work/fault.png" \
+    2>"$work/err"; status=$?
+  case $fault in device-lost*) want="device was lost";; *) want="ran out of memory";; esac
+  [ $status -eq 1 ] && grep -q "$want" "$work/err" && grep -q "no image was written" "$work/err" &&
+    ! grep -qi "validation" "$work/err" && [ "$(cat "$work/fault.png")" = "precious" ] &&
+    ! ls "$work" | grep -q "fault.png." && ok || bad "$fault (status $status): $(cat "$work/err"; ls "$work")"
+done
+SNELL_INJECT_FAULT=cosmic-ray "$SNELL" render "$SCENES/basic.scn" -o "$work/x.png" 2>"$work/err"; status=$?
+[ $status -eq 2 ] && grep -q "unknown fault" "$work/err" && ok || bad "bad SNELL_INJECT_FAULT ($status)"
+
 echo "cli: $pass passed, $fail failed"
 [ $fail -eq 0 ]

@@ -3,6 +3,7 @@
 #include <atomic>
 #include <chrono>
 #include <csignal>
+#include <cstdlib>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -60,6 +61,7 @@ struct RenderOptions {
     bool stats = false;
     bool quiet = false;
     bool validation = false;
+    snell::vk::FaultInjection fault;  // $SNELL_INJECT_FAULT, for tests
 };
 
 std::string jsonString(const std::string& s) {
@@ -185,6 +187,7 @@ int runRender(const RenderOptions& o) {
             snell::vk::ContextOptions options;
             options.deviceIndex = o.gpu;
             options.validation = o.validation;
+            options.fault = o.fault;
             snell::vk::Context context(options);
             device = context.deviceName();
             snell::ComputeRenderer renderer(
@@ -353,6 +356,15 @@ int main(int argc, char** argv) {
     }
     std::signal(SIGINT, onSignal);
     std::signal(SIGTERM, onSignal);
+    // A testing hook (README, "Tests"): simulate a failing GPU.
+    if (const char* fault = std::getenv("SNELL_INJECT_FAULT"); fault && *fault) {
+        try {
+            ro.fault = snell::vk::parseFaultInjection(fault);
+        } catch (const std::invalid_argument& e) {
+            std::cerr << "snell: error: SNELL_INJECT_FAULT: " << e.what() << "\n";
+            return kExitInput;
+        }
+    }
     if (render->parsed()) return runRender(ro);
     if (app.got_subcommand("devices")) return runDevices();
     if (compare->parsed()) return runCompare(compareA, compareB, compareDiff, compareThreshold);

@@ -339,7 +339,7 @@ GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool count
             VkSubmitInfo info{VK_STRUCTURE_TYPE_SUBMIT_INFO};
             info.commandBufferCount = 1;
             info.pCommandBuffers = &cmd;
-            check(vkQueueSubmit(context_.queue(), 1, &info, p.fence), "vkQueueSubmit");
+            check(context_.submit(info, p.fence), "vkQueueSubmit");
             check(vkWaitForFences(device, 1, &p.fence, VK_TRUE, UINT64_MAX), "vkWaitForFences");
             check(vkResetFences(device, 1, &p.fence), "vkResetFences");
             if (timed) {

@@ -174,7 +174,8 @@ void check(VkResult result, const char* call) {
                    "no image was written. Try a smaller --size, or update the driver";
         break;
     case VK_ERROR_OUT_OF_DEVICE_MEMORY:
-        message += ": the device ran out of memory; try a smaller --size or a scene with fewer spheres";
+        message += ": the device ran out of memory; no image was written. Try a smaller --size or a scene with fewer "
+                   "spheres";
         break;
     case VK_ERROR_OUT_OF_HOST_MEMORY:
         message += ": the host ran out of memory";
@@ -182,6 +183,33 @@ void check(VkResult result, const char* call) {
     default: break;
     }
     throw VulkanError(message, result);
+}
+
+FaultInjection parseFaultInjection(const std::string& text) {
+    FaultInjection f;
+    const std::size_t colon = text.find(':');
+    const std::string kind = text.substr(0, colon);
+    if (kind == "device-lost") f.kind = FaultInjection::Kind::DeviceLost;
+    else if (kind == "out-of-device-memory") f.kind = FaultInjection::Kind::OutOfDeviceMemory;
+    else throw std::invalid_argument("unknown fault '" + kind + "' (device-lost or out-of-device-memory)");
+    if (colon != std::string::npos) {
+        const std::string n = text.substr(colon + 1);
+        if (n.empty() || n.size() > 9 || n.find_first_not_of("0123456789") != std::string::npos || std::stoul(n) == 0)
+            throw std::invalid_argument("fault count '" + n + "' is not a positive integer");
+        f.at = static_cast<std::uint32_t>(std::stoul(n));
+    }
+    return f;
+}
+
+VkResult Context::submit(const VkSubmitInfo& info, VkFence fence) {
+    if (fault_.kind == FaultInjection::Kind::DeviceLost && ++submissions_ == fault_.at) return VK_ERROR_DEVICE_LOST;
+    return vkQueueSubmit(queue_, 1, &info, fence);
+}
+
+VkResult Context::allocate(const VkMemoryAllocateInfo& info, VkDeviceMemory* memory) {
+    if (fault_.kind == FaultInjection::Kind::OutOfDeviceMemory && ++allocations_ == fault_.at)
+        return VK_ERROR_OUT_OF_DEVICE_MEMORY;
+    return vkAllocateMemory(device_, &info, nullptr, memory);
 }
 
 std::vector<DeviceReport> Context::listDevices() {
@@ -202,7 +230,7 @@ std::vector<DeviceReport> Context::listDevices() {
     return reports;
 }
 
-Context::Context(const ContextOptions& options) {
+Context::Context(const ContextOptions& options) : fault_(options.fault) {
     bool debugUtils = false;
     instance_ = createInstance(options.instanceExtensions, options.validation, debugUtils);
     try {
@@ -362,7 +390,7 @@ Buffer Context::createBuffer(VkDeviceSize size, VkBufferUsageFlags usage, bool h
             ? findMemoryType(req.memoryTypeBits, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT,
                              VK_MEMORY_PROPERTY_HOST_CACHED_BIT)
             : findMemoryType(req.memoryTypeBits, 0, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
-        check(vkAllocateMemory(device_, &alloc, nullptr, &b.memory), "vkAllocateMemory");
+        check(allocate(alloc, &b.memory), "vkAllocateMemory");
         check(vkBindBufferMemory(device_, b.buffer, b.memory, 0), "vkBindBufferMemory");
         if (hostVisible) check(vkMapMemory(device_, b.memory, 0, VK_WHOLE_SIZE, 0, &b.mapped), "vkMapMemory");
     } catch (...) {
@@ -437,7 +465,7 @@ StorageImage Context::createStorageImage(std::uint32_t width, std::uint32_t heig
         VkMemoryAllocateInfo alloc{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
         alloc.allocationSize = req.size;
         alloc.memoryTypeIndex = findMemoryType(req.memoryTypeBits, 0, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
-        check(vkAllocateMemory(device_, &alloc, nullptr, &img.memory), "vkAllocateMemory");
+        check(allocate(alloc, &img.memory), "vkAllocateMemory");
         check(vkBindImageMemory(device_, img.image, img.memory, 0), "vkBindImageMemory");
         VkImageViewCreateInfo view{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
         view.image = img.image;
@@ -480,7 +508,7 @@ void Context::endOneOffAndWait(VkCommandBuffer cmd) {
         VkSubmitInfo submit{VK_STRUCTURE_TYPE_SUBMIT_INFO};
         submit.commandBufferCount = 1;
         submit.pCommandBuffers = &cmd;
-        r = vkQueueSubmit(queue_, 1, &submit, fence_);
+        r = this->submit(submit, fence_);
         if (r == VK_SUCCESS) {
             r = vkWaitForFences(device_, 1, &fence_, VK_TRUE, UINT64_MAX);
             const VkResult reset = vkResetFences(device_, 1, &fence_);

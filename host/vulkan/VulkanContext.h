@@ -34,11 +34,25 @@ const char* resultName(VkResult result);
 void check(VkResult result, const char* call);
 #define SNELL_VK_CHECK(call) ::snell::vk::check((call), #call)
 
+// A testing hook: the driver's Nth queue submission fails with
+// VK_ERROR_DEVICE_LOST, or its Nth memory allocation with
+// VK_ERROR_OUT_OF_DEVICE_MEMORY, as a failing GPU would report them, so the
+// error paths are tested without one (snell reads $SNELL_INJECT_FAULT).
+struct FaultInjection {
+    enum class Kind { None, DeviceLost, OutOfDeviceMemory };
+    Kind kind = Kind::None;
+    std::uint32_t at = 1;  // the Nth submission or allocation, from 1
+};
+
+// "device-lost[:N]" or "out-of-device-memory[:N]"; throws std::invalid_argument.
+FaultInjection parseFaultInjection(const std::string& text);
+
 struct ContextOptions {
     int deviceIndex = -1;         // -1: choose (discrete GPU first); else this index
     bool validation = false;      // enable VK_LAYER_KHRONOS_validation
     std::vector<std::string> instanceExtensions;  // e.g. what GLFW needs
     std::vector<std::string> deviceExtensions;
+    FaultInjection fault;
 };
 
 struct DeviceReport {
@@ -98,6 +112,9 @@ public:
     StorageImage createStorageImage(std::uint32_t width, std::uint32_t height, VkFormat format);
     void destroy(StorageImage& image);
 
+    // vkQueueSubmit on the context's queue (through the fault-injection hook).
+    VkResult submit(const VkSubmitInfo& info, VkFence fence);
+
     // Record and run a one-off command buffer, waiting for it to finish.
     template <typename Record>
     void submitAndWait(Record record) {
@@ -113,6 +130,7 @@ private:
     std::uint32_t findMemoryType(std::uint32_t typeBits, VkMemoryPropertyFlags required,
                                  VkMemoryPropertyFlags preferred) const;
     void release();
+    VkResult allocate(const VkMemoryAllocateInfo& info, VkDeviceMemory* memory);
     VkCommandBuffer beginOneOff();
     void endOneOffAndWait(VkCommandBuffer cmd);
     static VKAPI_ATTR VkBool32 VKAPI_CALL debugCallback(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
@@ -137,6 +155,8 @@ private:
     std::string driverInfo_;
     std::vector<DeviceReport> reports_;
     std::uint32_t validationMessages_ = 0;
+    FaultInjection fault_;
+    std::uint32_t submissions_ = 0, allocations_ = 0;
 };
 
 }  // namespace snell::vk
