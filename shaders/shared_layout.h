@@ -56,7 +56,8 @@ using uint = std::uint32_t;
 #define SNELL_SPEC_RAY_STACK 7
 #define SNELL_SPEC_AMPLIFYING 8
 #define SNELL_SPEC_LOOP_BUDGET 9
-#define SNELL_SPEC_COUNT 10
+#define SNELL_SPEC_SHADOWS 10
+#define SNELL_SPEC_COUNT 11
 
 // Sphere::ellipsoid when the sphere is a true sphere (centre + radius).
 #define SNELL_NOT_ELLIPSOID 0xffffffffu
@@ -168,7 +169,11 @@ struct FrameParams {
     uint sphereCount;
     uint lightCount;
     uint bvhNodeCount;
+    uint firstSample;   // trace sub-pixel samples firstSample .. firstSample + sampleCount − 1
+    uint sampleCount;   // of the supersample² grid (row-major), and output their mean
     uint pad0;
+    uint pad1;
+    uint pad2;
 };
 
 // Push constants: the tile of the image this dispatch covers.

@@ -28,6 +28,8 @@ layout(constant_id = SNELL_SPEC_AMPLIFYING) const bool AMPLIFYING = false;
 // Loop iterations a subgroup may spend in one dispatch before its pixels
 // suspend; 0: no limit (drivers without llvmpipe's loop limiter).
 layout(constant_id = SNELL_SPEC_LOOP_BUDGET) const uint LOOP_BUDGET = 0u;
+// Off (a preview inspection switch): no shadow rays, every light is seen.
+layout(constant_id = SNELL_SPEC_SHADOWS) const bool SHADOWS = true;
 
 layout(set = 0, binding = SNELL_BINDING_OUTPUT_IMAGE, rgba32f) uniform writeonly image2D outputImage;
 layout(set = 0, binding = SNELL_BINDING_FRAME, std140) uniform FrameBlock { FrameParams frame; };
@@ -210,8 +212,8 @@ vec3 shade(Material m, rvec3 x, rvec3 n, rvec3 v, uint hitSphere, bool fromOutsi
             l /= distance;
             float nl = float(dot(n, l));
             if (nl > 0.0) {
-                if (COUNT_RAYS) countedRays[SNELL_COUNTER_SHADOW]++;
-                if (!occluded(x, l, distance, hitSphere, start)) {
+                if (COUNT_RAYS && SHADOWS) countedRays[SNELL_COUNTER_SHADOW]++;
+                if (!SHADOWS || !occluded(x, l, distance, hitSphere, start)) {
                     float rv = float(dot(2.0 * dot(n, l) * n - l, v));
                     float specular = rv > 0.0 ? pow(rv, m.kd.w) : 0.0;
                     local += lights[j].colour.rgb * (m.kd.rgb * nl + m.ks.rgb * specular);
@@ -408,7 +410,7 @@ void main() {
     }
     // SPEC §3: s×s rays through (i + (a+½)/s, j + (b+½)/s); mean, then clamp on output.
     uint s = frame.supersample;
-    uint samples = s * s;
+    uint samples = frame.sampleCount;
     float saturation = AMPLIFYING ? float(samples) : 3.0e38;
     uvec2 imagePixel = local + uvec2(tile.originX, tile.originY);
 
@@ -433,7 +435,8 @@ void main() {
                     done = true;
                 } else {
                     // Camera: the next primary ray of this pixel.
-                    uvec2 ab = uvec2(state.started % s, state.started / s);
+                    uint k = frame.firstSample + state.started;
+                    uvec2 ab = uvec2(k % s, k / s);
                     rvec2 p = rvec2(imagePixel) + (rvec2(ab) + 0.5) / real(s);
                     rvec3 corner = WIDE(frame.cornerDir, frameLow.cornerDir).xyz;
                     rvec3 right = WIDE(frame.pixelRight, frameLow.pixelRight).xyz;

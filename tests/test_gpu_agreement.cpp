@@ -211,3 +211,42 @@ TEST_P(GpuAgreement, MatchesCpuReference) {
 INSTANTIATE_TEST_SUITE_P(Scenes, GpuAgreement, testing::ValuesIn(allCases()), testName);
 
 }  // namespace
+
+namespace {
+
+// The preview's inspection switches and progressive samples, against the
+// reference with the same settings.
+TEST(GpuInspection, SwitchesAndProgressiveSamplesMatchReference) {
+    const snell::Scene scene = snell::parseSceneFile(SNELL_SOURCE_DIR "/scenes/showcase.scn");
+    snell::RenderRequest request;
+    request.width = request.height = 64;
+    request.supersample = 2;
+    request.camera = snell::Camera::fromSpec(64, scene.halfWidth);
+    snell::ComputeRenderer gpu(context(), scene, request.camera);
+    const snell::CpuRenderer cpu(scene);
+    const snell::Image full = gpu.render(request, false).image;
+    for (int k = 0; k < 3; ++k) {
+        snell::RenderRequest r = request;
+        r.trace = snell::kDefaultSettings;
+        (k == 0 ? r.trace.shadows : k == 1 ? r.trace.reflection : r.trace.refraction) = false;
+        const snell::Image g = gpu.render(r, false).image;
+        r.trace.minWeight = snell::kReferenceSettings.minWeight;
+        const snell::ImageMetrics m = snell::compareImages(g, cpu.render(r), kBadThreshold);
+        EXPECT_LE(m.meanAbsError, kMaxMeanError) << "switch " << k;
+        EXPECT_LE(m.badFraction, kMaxBadFraction) << "switch " << k;
+        EXPECT_GT(snell::compareImages(g, full, kBadThreshold).meanAbsError, 0.5) << "switch " << k << " changed nothing";
+    }
+    // Four one-sample renders average to the 2×2 supersampled image.
+    snell::Image mean(64, 64);
+    for (int sample = 0; sample < 4; ++sample) {
+        snell::RenderRequest r = request;
+        r.firstSample = sample;
+        r.sampleCount = 1;
+        const snell::Image one = gpu.render(r, false).image;
+        for (std::size_t i = 0; i < mean.rgb.size(); ++i) mean.rgb[i] += 0.25f * one.rgb[i];
+    }
+    const snell::ImageMetrics m = snell::compareImages(mean, full, kBadThreshold);
+    EXPECT_LE(m.maxError, 1);
+}
+
+}  // namespace

@@ -62,7 +62,7 @@ TEST(Layout, BvhNode) {
 }
 
 TEST(Layout, FrameParams) {
-    EXPECT_EQ(sizeof(gpu::FrameParams), 128u);
+    EXPECT_EQ(sizeof(gpu::FrameParams), 144u);
     EXPECT_EQ(offsetof(gpu::FrameParams, primaryStart), 0u);
     EXPECT_EQ(offsetof(gpu::FrameParams, cornerDir), 16u);
     EXPECT_EQ(offsetof(gpu::FrameParams, pixelRight), 32u);
@@ -76,7 +76,8 @@ TEST(Layout, FrameParams) {
     EXPECT_EQ(offsetof(gpu::FrameParams, sphereCount), 112u);
     EXPECT_EQ(offsetof(gpu::FrameParams, lightCount), 116u);
     EXPECT_EQ(offsetof(gpu::FrameParams, bvhNodeCount), 120u);
-    EXPECT_EQ(offsetof(gpu::FrameParams, pad0), 124u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, firstSample), 124u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, sampleCount), 128u);
 }
 
 TEST(Layout, TileParams) {
@@ -168,7 +169,7 @@ TEST(GpuScene, SmallSceneIsOriginRelativeAndClassified) {
     EXPECT_FLOAT_EQ(g.lights[0].colour.r, 0.7f);
     EXPECT_FLOAT_EQ(g.lights[0].colour.b, 0.9f);
 
-    const gpu::FrameParams f = gpu::makeFrameParams(s, g, camera, 10, 10, 1, 32, 1e-4);
+    const gpu::FrameParams f = gpu::makeFrameParams(s, g, camera, 10, 10, 1, 0, 0, 32, 1e-4);
     EXPECT_EQ(f.sphereCount, 2u);
     EXPECT_EQ(f.lightCount, 1u);
     EXPECT_EQ(f.bvhNodeCount, 0u);

@@ -19,6 +19,7 @@
 #include <CLI/CLI.hpp>
 
 #include "gpu/ComputeRenderer.h"
+#include "preview/Preview.h"
 #include "image/ImageIO.h"
 #include "metrics/ImageMetrics.h"
 #include "reference/CpuRenderer.h"
@@ -269,6 +270,23 @@ int runCompare(const std::string& a, const std::string& b, const std::string& di
     return 0;
 }
 
+int runPreviewCommand(const snell::PreviewOptions& o) {
+    try {
+        snell::runPreview(o);
+    } catch (const snell::ParseError& e) {
+        std::cerr << e.what() << "\n";
+        return kExitInput;
+    } catch (const snell::vk::VulkanError& e) {
+        if (gInterrupted.load()) return kExitInterrupted;
+        std::cerr << "snell: error: " << e.what() << "\n";
+        return kExitRuntime;
+    } catch (const std::runtime_error& e) {  // WindowError, ImageIOError
+        std::cerr << "snell: error: " << e.what() << "\n";
+        return kExitRuntime;
+    }
+    return gInterrupted.load() ? kExitInterrupted : 0;
+}
+
 int runDevices() {
     try {
         const auto reports = snell::vk::Context::listDevices();
@@ -330,6 +348,30 @@ int main(int argc, char** argv) {
     render->add_flag("--validation", ro.validation, "Enable the Khronos validation layer; any message fails the render")
         ->envname("SNELL_VALIDATION");
 
+    snell::PreviewOptions po;
+    std::string previewPrecision = "fp32";
+    po.cancel = &gInterrupted;
+    CLI::App* preview = app.add_subcommand("preview", "Show a scene in a window, live: orbit, inspect, hot reload");
+    preview->footer(snell::kPreviewKeys);
+    preview->add_option("scene", po.scene, "Scene file (re-rendered when saved)")->required();
+    preview->add_option("-s,--size", po.size, "Rendered image size in pixels (default: the scene's view n)")
+        ->check(CLI::Range(1, 4096));
+    preview->add_option("-d,--depth", po.depth, "Initial maximum depth (default: 64)")->check(CLI::Range(0, 256));
+    preview->add_option("--min-weight", po.minWeight, "Stop rays whose weight falls below W (default: 1e-4)")
+        ->check(CLI::Range(0.0, 1.0));
+    preview->add_option("--spp,--supersample", po.supersample, "Rays per pixel per axis when supersampling is on")
+        ->check(CLI::Range(1, snell::ParseLimits::kMaxSupersample));
+    preview->add_option("--gpu", po.gpu, "Vulkan device index (default: $SNELL_GPU, else the best)")
+        ->envname("SNELL_GPU")->check(CLI::NonNegativeNumber);
+    preview->add_option("--precision", previewPrecision, "GPU arithmetic for geometry: fp32 (default) or fp64")
+        ->check(CLI::IsMember({"fp32", "fp64"}));
+    preview->add_flag("--validation", po.validation, "Enable the Khronos validation layer")->envname("SNELL_VALIDATION");
+    preview->add_flag("-q,--quiet", po.quiet, "No warnings or reload timings on stderr");
+    CLI::Option* frames = preview->add_option("--frames", po.frames, "Scripted: show N frames, then save --screenshot and exit")
+        ->check(CLI::PositiveNumber);
+    preview->add_option("--screenshot", po.screenshot, "Scripted: the PNG to save after --frames frames")->needs(frames);
+    preview->add_option("--orbit", po.orbitDegrees, "Scripted: orbit the camera by DEGREES before the first frame");
+
     std::string compareA, compareB, compareDiff;
     int compareThreshold = 3;
     CLI::App* compare = app.add_subcommand("compare", "Error metrics of image A against reference B, as JSON (8-bit units)");
@@ -366,6 +408,10 @@ int main(int argc, char** argv) {
         }
     }
     if (render->parsed()) return runRender(ro);
+    if (preview->parsed()) {
+        po.precision = previewPrecision == "fp64" ? snell::gpu::Precision::Fp64 : snell::gpu::Precision::Fp32;
+        return runPreviewCommand(po);
+    }
     if (app.got_subcommand("devices")) return runDevices();
     if (compare->parsed()) return runCompare(compareA, compareB, compareDiff, compareThreshold);
     std::cout << app.help();

@@ -40,6 +40,10 @@ struct ComputeRenderer::Pipeline {
     std::uint32_t rayStackDepth = 1;  // the RAY_STACK specialisation
     std::uint32_t maxMedia = 1;       // the MAX_MEDIA specialisation
     std::uint32_t bindingCount = SNELL_BINDING_COUNT_FP32;
+    // What it was built for: kept between renders and reused while these match.
+    Specialisation values{};
+    int tileW = 0, tileH = 0;
+    bool imageReadable = false;  // the image is in TRANSFER_SRC layout (after a copy)
     vk::StorageImage image;
 };
 
@@ -79,7 +83,10 @@ ComputeRenderer::ComputeRenderer(vk::Context& context, const Scene& scene, const
     uploadMs_ = msSince(start);
 }
 
-ComputeRenderer::~ComputeRenderer() { destroyBuffers(); }
+ComputeRenderer::~ComputeRenderer() {
+    if (cached_) destroyPipeline(*cached_);
+    destroyBuffers();
+}
 
 void ComputeRenderer::destroyBuffers() {
     for (vk::Buffer* b :
@@ -87,8 +94,31 @@ void ComputeRenderer::destroyBuffers() {
         context_.destroy(*b);
 }
 
-void ComputeRenderer::createPipeline(const RenderRequest& request, bool countRays, Pipeline& p) {
+ComputeRenderer::Specialisation ComputeRenderer::specialise(const RenderRequest& request, bool countRays) const {
+    // Specialise to the scene: only what it uses is compiled.
+    const bool hasRefraction = layout_.refractiveSpheres > 0 && request.trace.refraction;
+    const bool hasReflection = scene_.anyReflection() && request.trace.reflection;
+    Specialisation values{};
+    values[SNELL_SPEC_USE_BVH] = !layout_.nodes.empty();
+    values[SNELL_SPEC_HAS_ELLIPSOIDS] = !layout_.ellipsoids.empty();
+    values[SNELL_SPEC_HAS_REFRACTION] = hasRefraction;
+    values[SNELL_SPEC_HAS_REFLECTION] = hasReflection;
+    values[SNELL_SPEC_SHADOWS] = request.trace.shadows;
+    values[SNELL_SPEC_HAS_LIGHTS] = !layout_.lights.empty();
+    values[SNELL_SPEC_COUNT_RAYS] = countRays;
+    values[SNELL_SPEC_MAX_MEDIA] = static_cast<std::uint32_t>(
+        std::clamp<std::size_t>(layout_.refractiveSpheres, 1, SNELL_MAX_MEDIA_LIMIT));
+    // Depth-first with two children per ray: at most maxDepth + 1 rays wait.
+    values[SNELL_SPEC_RAY_STACK] = static_cast<std::uint32_t>(
+        (hasRefraction || hasReflection) ? request.trace.maxDepth + 1 : 1);
+    values[SNELL_SPEC_AMPLIFYING] = layout_.amplifying;
+    values[SNELL_SPEC_LOOP_BUDGET] = context_.isLlvmpipe() ? SNELL_LOOP_BUDGET_LLVMPIPE : 0u;
+    return values;
+}
+
+void ComputeRenderer::createPipeline(const Specialisation& values, Pipeline& p) {
     VkDevice device = context_.device();
+    p.values = values;
     const bool wide = layout_.precision == gpu::Precision::Fp64;
     p.bindingCount = wide ? SNELL_BINDING_COUNT : SNELL_BINDING_COUNT_FP32;
     std::array<VkDescriptorSetLayoutBinding, SNELL_BINDING_COUNT> bindings{};
@@ -119,22 +149,6 @@ void ComputeRenderer::createPipeline(const RenderRequest& request, bool countRay
     moduleInfo.pCode = wide ? snell_trace_fp64_comp_spv : snell_trace_comp_spv;
     check(vkCreateShaderModule(device, &moduleInfo, nullptr, &p.module), "vkCreateShaderModule");
 
-    // Specialise to the scene: only what it uses is compiled.
-    const bool hasRefraction = layout_.refractiveSpheres > 0;
-    std::array<std::uint32_t, SNELL_SPEC_COUNT> values{};
-    values[SNELL_SPEC_USE_BVH] = !layout_.nodes.empty();
-    values[SNELL_SPEC_HAS_ELLIPSOIDS] = !layout_.ellipsoids.empty();
-    values[SNELL_SPEC_HAS_REFRACTION] = hasRefraction;
-    values[SNELL_SPEC_HAS_REFLECTION] = scene_.anyReflection();
-    values[SNELL_SPEC_HAS_LIGHTS] = !layout_.lights.empty();
-    values[SNELL_SPEC_COUNT_RAYS] = countRays;
-    values[SNELL_SPEC_MAX_MEDIA] = static_cast<std::uint32_t>(
-        std::clamp<std::size_t>(layout_.refractiveSpheres, 1, SNELL_MAX_MEDIA_LIMIT));
-    // Depth-first with two children per ray: at most maxDepth + 1 rays wait.
-    values[SNELL_SPEC_RAY_STACK] = static_cast<std::uint32_t>(
-        (hasRefraction || scene_.anyReflection()) ? request.trace.maxDepth + 1 : 1);
-    values[SNELL_SPEC_AMPLIFYING] = layout_.amplifying;
-    values[SNELL_SPEC_LOOP_BUDGET] = context_.isLlvmpipe() ? SNELL_LOOP_BUDGET_LLVMPIPE : 0u;
     p.rayStackDepth = values[SNELL_SPEC_RAY_STACK];
     p.maxMedia = values[SNELL_SPEC_MAX_MEDIA];
     std::array<VkSpecializationMapEntry, SNELL_SPEC_COUNT> entries{};
@@ -237,24 +251,20 @@ constexpr VkDeviceSize kTileStateBudget = 64ull << 20;
 }  // namespace
 
 GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool countRays) {
-    if (request.camera.eye != layout_.eye)
-        throw vk::VulkanError("internal error: the camera moved without rebuilding the GPU scene");
     GpuRenderResult result;
     if (!request.rowSink) result.image = Image(request.width, request.height);
-    Pipeline p;
     VkDevice device = context_.device();
     try {
         const auto pipelineStart = Clock::now();
-        createPipeline(request, countRays, p);
-        result.pipelineMs = msSince(pipelineStart);
+        const Specialisation values = specialise(request, countRays);
 
         // Tiles: square, a multiple of the workgroup, as large as the memory for
         // the pixels' ray stacks allows (at most 1024²).
         const int s = std::max(1, request.supersample);
         const bool wide = layout_.precision == gpu::Precision::Fp64;  // a low part per pending ray too
         const VkDeviceSize bytesPerPixel =
-            sizeof(gpu::PixelState) +
-            VkDeviceSize(p.rayStackDepth) * ((wide ? 2 : 1) * sizeof(gpu::PendingRay) + p.maxMedia * 4);
+            sizeof(gpu::PixelState) + VkDeviceSize(values[SNELL_SPEC_RAY_STACK]) *
+                                          ((wide ? 2 : 1) * sizeof(gpu::PendingRay) + values[SNELL_SPEC_MAX_MEDIA] * 4);
         const VkDeviceSize limit = context_.properties().limits.maxStorageBufferRange;
         const VkDeviceSize maxPixels = std::min(kTileStateBudget, limit) / bytesPerPixel;
         const int tileSide = std::clamp(static_cast<int>(std::sqrt(double(maxPixels))) / 8 * 8, 8, 1024);
@@ -262,24 +272,41 @@ GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool count
         const int tileH = std::min(tileSide, request.height);
         const VkDeviceSize tilePixels = VkDeviceSize(tileW) * tileH;
 
-        gpu::FrameParams frameLow{};
-        const gpu::FrameParams frame = gpu::makeFrameParams(scene_, layout_, request.camera, request.width,
-                                                            request.height, s, request.trace.maxDepth,
-                                                            request.trace.minWeight, &frameLow);
-        p.frame = context_.createBufferWithData(&frame, sizeof frame, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
-        p.counters = context_.createBuffer(SNELL_COUNTER_COUNT * sizeof(std::uint32_t), kStorage, true);
-        p.pixelStates = context_.createBuffer(tilePixels * sizeof(gpu::PixelState),
-                                              kStorage | VK_BUFFER_USAGE_TRANSFER_DST_BIT, false);
-        p.rayStack = context_.createBuffer(tilePixels * p.rayStackDepth * sizeof(gpu::PendingRay), kStorage, false);
-        p.mediaStack = context_.createBuffer(tilePixels * p.rayStackDepth * p.maxMedia * 4, kStorage, false);
-        if (wide) {
-            p.frameLow = context_.createBufferWithData(&frameLow, sizeof frameLow, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
-            p.rayStackLow = context_.createBuffer(tilePixels * p.rayStackDepth * sizeof(gpu::PendingRay), kStorage,
-                                                  false);
+        // The pipeline and the tile's buffers of the last render serve again
+        // when the specialisation and tile size are the same (the preview).
+        const bool reuse = cached_ && cached_->values == values && cached_->tileW == tileW && cached_->tileH == tileH;
+        if (!reuse) {
+            if (cached_) destroyPipeline(*cached_);
+            cached_ = std::make_unique<Pipeline>();
+            createPipeline(values, *cached_);
+            cached_->tileW = tileW;
+            cached_->tileH = tileH;
         }
-        p.image = context_.createStorageImage(tileW, tileH, VK_FORMAT_R32G32B32A32_SFLOAT);
-        p.readback = context_.createBuffer(VkDeviceSize(tileW) * tileH * 4 * sizeof(float),
-                                           VK_BUFFER_USAGE_TRANSFER_DST_BIT, true);
+        Pipeline& p = *cached_;
+
+        gpu::FrameParams frameLow{};
+        const gpu::FrameParams frame = gpu::makeFrameParams(
+            scene_, layout_, request.camera, request.width, request.height, s, request.firstSample,
+            request.sampleCount, request.trace.maxDepth, request.trace.minWeight, &frameLow);
+        context_.destroy(p.frame);
+        context_.destroy(p.frameLow);
+        p.frame = context_.createBufferWithData(&frame, sizeof frame, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
+        if (wide)
+            p.frameLow = context_.createBufferWithData(&frameLow, sizeof frameLow, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
+        if (!reuse) {
+            p.counters = context_.createBuffer(SNELL_COUNTER_COUNT * sizeof(std::uint32_t), kStorage, true);
+            p.pixelStates = context_.createBuffer(tilePixels * sizeof(gpu::PixelState),
+                                                  kStorage | VK_BUFFER_USAGE_TRANSFER_DST_BIT, false);
+            p.rayStack =
+                context_.createBuffer(tilePixels * p.rayStackDepth * sizeof(gpu::PendingRay), kStorage, false);
+            p.mediaStack = context_.createBuffer(tilePixels * p.rayStackDepth * p.maxMedia * 4, kStorage, false);
+            if (wide)
+                p.rayStackLow =
+                    context_.createBuffer(tilePixels * p.rayStackDepth * sizeof(gpu::PendingRay), kStorage, false);
+            p.image = context_.createStorageImage(tileW, tileH, VK_FORMAT_R32G32B32A32_SFLOAT);
+            p.readback = context_.createBuffer(VkDeviceSize(tileW) * tileH * 4 * sizeof(float),
+                                               VK_BUFFER_USAGE_TRANSFER_DST_BIT, true);
+        }
 
         VkDescriptorImageInfo imageInfo{VK_NULL_HANDLE, p.image.view, VK_IMAGE_LAYOUT_GENERAL};
         std::array<VkDescriptorBufferInfo, SNELL_BINDING_COUNT> bufferInfo{};
@@ -356,8 +383,7 @@ GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool count
 
         // An empty dispatch first: llvmpipe compiles a shader at its first
         // dispatch, and that belongs to pipeline creation, not to the render.
-        {
-            const auto warmStart = Clock::now();
+        if (!reuse) {
             const gpu::TileParams empty{0, 0, 0, 0};
             std::memset(p.counters.mapped, 0, SNELL_COUNTER_COUNT * sizeof(std::uint32_t));
             submit([](VkCommandBuffer) {}, [&](VkCommandBuffer cmd) {
@@ -369,8 +395,8 @@ GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool count
                 vkCmdPushConstants(cmd, p.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof empty, &empty);
                 vkCmdDispatch(cmd, 1, 1, 1);
             }, false);
-            result.pipelineMs += msSince(warmStart);
         }
+        result.pipelineMs = msSince(pipelineStart);
 
         // Streaming rows: one band of tile rows at a time.
         Image band = request.rowSink ? Image(request.width, tileH) : Image();
@@ -378,7 +404,7 @@ GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool count
         const int tilesY = (request.height + tileH - 1) / tileH;
         const int tileCount = tilesX * tilesY;
         auto* counters = static_cast<std::uint32_t*>(p.counters.mapped);
-        bool imageUsed = false;
+        bool& imageUsed = p.imageReadable;
         for (int ty = 0; ty < tilesY; ++ty) {
             for (int tx = 0; tx < tilesX; ++tx) {
                 gpu::TileParams tile{std::uint32_t(tx * tileW), std::uint32_t(ty * tileH),
@@ -468,10 +494,11 @@ GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool count
         result.gpuTimed = p.queries != VK_NULL_HANDLE;
         result.renderMs = result.gpuTimed ? gpuRenderMs : hostRenderMs;
     } catch (...) {
-        destroyPipeline(p);
+        // Whatever failed, the kept pipeline's state is unknown: start afresh.
+        if (cached_) destroyPipeline(*cached_);
+        cached_.reset();
         throw;
     }
-    destroyPipeline(p);
     return result;
 }
 

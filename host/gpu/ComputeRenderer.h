@@ -3,6 +3,8 @@
 // in tiles so no single submission runs for long.
 #pragma once
 
+#include <array>
+#include <cstdint>
 #include <memory>
 
 #include "gpu/GpuScene.h"
@@ -36,12 +38,16 @@ public:
     double uploadMs() const { return uploadMs_; }
     const gpu::GpuScene& layout() const { return layout_; }
 
-    // Render request.camera (its eye must be the one given at construction).
+    // Render request.camera (any camera; coordinates stay relative to the
+    // origin chosen for the construction camera). The pipeline and tile
+    // buffers are kept for the next render, which reuses them when it can.
     GpuRenderResult render(const RenderRequest& request, bool countRays);
 
 private:
     struct Pipeline;
-    void createPipeline(const RenderRequest& request, bool countRays, Pipeline& pipeline);
+    using Specialisation = std::array<std::uint32_t, SNELL_SPEC_COUNT>;
+    Specialisation specialise(const RenderRequest& request, bool countRays) const;
+    void createPipeline(const Specialisation& values, Pipeline& pipeline);
     void destroyPipeline(Pipeline& pipeline);
     void destroyBuffers();
 
@@ -51,6 +57,7 @@ private:
     vk::Buffer spheres_, ellipsoids_, materials_, lights_, nodes_;
     vk::Buffer sphereLows_, ellipsoidLows_, lightLows_;  // fp64 only
     double uploadMs_ = 0.0;
+    std::unique_ptr<Pipeline> cached_;  // the last render's, reused by the next when it fits
 };
 
 }  // namespace snell

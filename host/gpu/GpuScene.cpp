@@ -1,5 +1,6 @@
 #include "gpu/GpuScene.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -161,10 +162,13 @@ GpuScene buildGpuScene(const snell::Scene& scene, const snell::Camera& camera, P
 }
 
 FrameParams makeFrameParams(const snell::Scene& scene, const GpuScene& gpuScene, const snell::Camera& camera,
-                            int width, int height, int supersample, int maxDepth, double minWeight,
-                            FrameParams* lowParts) {
+                            int width, int height, int supersample, int firstSample, int sampleCount,
+                            int maxDepth, double minWeight, FrameParams* lowParts) {
     FrameParams f{}, low{};
-    splitVec4(camera.eye - gpuScene.origin, gpuScene.primaryStart, f.primaryStart, low.primaryStart);
+    // A camera other than the one the layout was built for (the preview's)
+    // needs its own start distance.
+    const double start = camera.eye == gpuScene.eye ? gpuScene.primaryStart : primaryStartDistance(scene, camera.eye);
+    splitVec4(camera.eye - gpuScene.origin, start, f.primaryStart, low.primaryStart);
     splitVec4(camera.cornerDir, 0.0, f.cornerDir, low.cornerDir);
     splitVec4(camera.pixelRight, 0.0, f.pixelRight, low.pixelRight);
     splitVec4(camera.pixelDown, 0.0, f.pixelDown, low.pixelDown);
@@ -174,6 +178,10 @@ FrameParams makeFrameParams(const snell::Scene& scene, const GpuScene& gpuScene,
     f.imageWidth = static_cast<uint>(width);
     f.imageHeight = static_cast<uint>(height);
     f.supersample = static_cast<uint>(supersample);
+    const int grid = supersample * supersample;
+    f.firstSample = static_cast<uint>(std::clamp(firstSample, 0, grid - 1));
+    f.sampleCount = static_cast<uint>(sampleCount > 0 ? std::min(sampleCount, grid - int(f.firstSample))
+                                                      : grid - int(f.firstSample));
     f.maxDepth = static_cast<uint>(maxDepth);
     f.sphereCount = static_cast<uint>(gpuScene.spheres.size());
     f.lightCount = static_cast<uint>(gpuScene.lights.size());

@@ -21,8 +21,9 @@ static_assert(sizeof(Material) == 48 && offsetof(Material, kt) == 32);
 static_assert(sizeof(Light) == 32 && offsetof(Light, colour) == 16);
 static_assert(sizeof(BvhNode) == 48 && offsetof(BvhNode, first) == 32 && offsetof(BvhNode, count) == 36 &&
               offsetof(BvhNode, skip) == 40);
-static_assert(sizeof(FrameParams) == 128 && offsetof(FrameParams, cornerDir) == 16 &&
-              offsetof(FrameParams, imageWidth) == 96 && offsetof(FrameParams, bvhNodeCount) == 120);
+static_assert(sizeof(FrameParams) == 144 && offsetof(FrameParams, cornerDir) == 16 &&
+              offsetof(FrameParams, imageWidth) == 96 && offsetof(FrameParams, bvhNodeCount) == 120 &&
+              offsetof(FrameParams, sampleCount) == 128);
 static_assert(sizeof(TileParams) == 16);
 static_assert(sizeof(PixelState) == 32 && offsetof(PixelState, started) == 16);
 static_assert(sizeof(PendingRay) == 64 && offsetof(PendingRay, depth) == 48 && offsetof(PendingRay, mediaCount) == 60);
@@ -63,8 +64,8 @@ double primaryStartDistance(const snell::Scene& scene, const snell::dvec3& eye);
 // The frame parameters of one render (camera relative to camera.eye); with
 // `lowParts`, also the low parts of its float pairs (for the fp64 shader).
 FrameParams makeFrameParams(const snell::Scene& scene, const GpuScene& gpuScene, const snell::Camera& camera,
-                            int width, int height, int supersample, int maxDepth, double minWeight,
-                            FrameParams* lowParts = nullptr);
+                            int width, int height, int supersample, int firstSample, int sampleCount,
+                            int maxDepth, double minWeight, FrameParams* lowParts = nullptr);
 
 // A double as the float pair hi + lo: hi = float(v), lo = float(v − hi).
 void splitDouble(double v, float& hi, float& lo);

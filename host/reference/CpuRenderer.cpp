@@ -209,9 +209,10 @@ void CpuRenderer::trace(const PendingRay& primary, dvec3& pixelSum, double satur
             l /= distance;
             const double nl = glm::dot(n, l);
             if (!(nl > 0.0)) continue;
-            ++counts.shadow;
+            if (settings.shadows) ++counts.shadow;
             // A shadow ray towards N's side enters the sphere only when N = −No.
-            if (occluded({x, l}, distance, hit.sphere, fromOutside ? StartsOn::Leaving : StartsOn::Entering))
+            if (settings.shadows &&
+                occluded({x, l}, distance, hit.sphere, fromOutside ? StartsOn::Leaving : StartsOn::Entering))
                 continue;
             const dvec3 reflectedLight = 2.0 * nl * n - l;
             const double rv = glm::dot(reflectedLight, v);
@@ -223,9 +224,9 @@ void CpuRenderer::trace(const PendingRay& primary, dvec3& pixelSum, double satur
 
         // 4–5. Children: reflection, and refraction through the medium stack.
         // Pushed reflection first, so refraction is traced next (as the shader).
-        dvec3 reflectedWeight = r.weight * m.ks;
+        dvec3 reflectedWeight = settings.reflection ? r.weight * m.ks : dvec3(0.0);
         std::optional<PendingRay> refractedRay;
-        if (m.refracts()) {
+        if (settings.refraction && m.refracts()) {
             const dvec3 transmittedWeight = r.weight * m.kt;
             MediumStack media = r.media;
             double etaI, etaT;
@@ -262,20 +263,21 @@ void CpuRenderer::trace(const PendingRay& primary, dvec3& pixelSum, double satur
 
 glm::dvec3 CpuRenderer::renderPixel(const RenderRequest& request, int x, int y, RayCounts& counts) const {
     const int s = std::max(1, request.supersample);
-    const double samples = static_cast<double>(s) * s;
+    const int first = std::clamp(request.firstSample, 0, s * s - 1);
+    const int count = request.sampleCount > 0 ? std::min(request.sampleCount, s * s - first) : s * s - first;
+    const double samples = count;
     // Only amplifying scenes stop saturated channels: elsewhere the float
     // output keeps the whole unclamped sum (SPEC §6).
     const double saturation = amplifying_ ? samples : kNoHit;
     dvec3 sum(0.0);
-    for (int b = 0; b < s; ++b) {
-        for (int a = 0; a < s; ++a) {
-            // SPEC §3: sub-pixel (a, b) at x = i + (a + ½)/s, y = j + (b + ½)/s.
-            const double px = x + (a + 0.5) / s;
-            const double py = y + (b + 0.5) / s;
-            PendingRay primary;
-            primary.ray = {request.camera.eye, request.camera.direction(px, py)};
-            trace(primary, sum, saturation, request.trace, counts);
-        }
+    for (int k = first; k < first + count; ++k) {
+        // SPEC §3: sub-pixel (a, b) at x = i + (a + ½)/s, y = j + (b + ½)/s.
+        const int a = k % s, b = k / s;
+        const double px = x + (a + 0.5) / s;
+        const double py = y + (b + 0.5) / s;
+        PendingRay primary;
+        primary.ray = {request.camera.eye, request.camera.direction(px, py)};
+        trace(primary, sum, saturation, request.trace, counts);
     }
     return sum / samples;
 }

@@ -13,12 +13,17 @@ namespace snell {
 struct TraceSettings {
     int maxDepth = 64;          // reflection/refraction generations below the primary ray
     double minWeight = 1e-7;    // Hall & Greenberg cut-off on a ray's weight; 0 turns it off
+    // Inspection switches (the preview's keys): off, shadow rays are not cast
+    // (every light is seen), or reflected / refracted rays are not spawned.
+    bool shadows = true;
+    bool reflection = true;
+    bool refraction = true;
 };
 
 // The converged settings used to compute the exact image (SPEC §4).
-inline constexpr TraceSettings kReferenceSettings{64, 1e-7};
+inline constexpr TraceSettings kReferenceSettings{64, 1e-7, true, true, true};
 // What `snell render` uses unless told otherwise (see README, "Defaults").
-inline constexpr TraceSettings kDefaultSettings{64, 1e-4};
+inline constexpr TraceSettings kDefaultSettings{64, 1e-4, true, true, true};
 
 struct RayCounts {
     std::uint64_t primary = 0;
@@ -33,6 +38,11 @@ struct RenderRequest {
     int width = 0;
     int height = 0;
     int supersample = 1;
+    // Of the supersample² rays per pixel (SPEC §3, row-major over the
+    // sub-pixel grid), trace those from firstSample on, sampleCount of them
+    // (0: all); the image is their mean. Progressive preview frames take one each.
+    int firstSample = 0;
+    int sampleCount = 0;
     TraceSettings trace;
     int threads = 0;  // 0: all hardware threads
     // Called now and then from worker threads with the fraction done.

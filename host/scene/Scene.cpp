@@ -29,13 +29,22 @@ bool Scene::anyRefraction() const { return refractiveSphereCount() > 0; }
 
 Camera Camera::fromSpec(int imageSize, double halfWidth) {
     // SPEC §3: P(x, y) = (-d + x*2d/n, d - y*2d/n, 0), eye E = (0, 0, 1).
+    return lookAt(dvec3(0.0, 0.0, 1.0), dvec3(0.0), dvec3(0.0, 1.0, 0.0), halfWidth, imageSize, imageSize);
+}
+
+Camera Camera::lookAt(const dvec3& eye, const dvec3& target, const dvec3& up, double halfWidth, int width,
+                      int height) {
     Camera c;
-    c.eye = dvec3(0.0, 0.0, 1.0);
-    c.forward = dvec3(0.0, 0.0, -1.0);
-    c.cornerDir = dvec3(-halfWidth, halfWidth, -1.0);
-    const double step = 2.0 * halfWidth / imageSize;
-    c.pixelRight = dvec3(step, 0.0, 0.0);
-    c.pixelDown = dvec3(0.0, -step, 0.0);
+    c.eye = eye;
+    c.forward = glm::normalize(target - eye);
+    const dvec3 right = glm::normalize(glm::cross(c.forward, up));
+    const dvec3 trueUp = glm::cross(right, c.forward);
+    // Square pixels; halfWidth spans the image's width.
+    const double step = 2.0 * halfWidth / width;
+    const double halfHeight = 0.5 * step * height;
+    c.cornerDir = c.forward - halfWidth * right + halfHeight * trueUp;
+    c.pixelRight = step * right;
+    c.pixelDown = -step * trueUp;
     return c;
 }
 

@@ -116,7 +116,14 @@ struct Camera {
     dvec3 pixelRight{0.0};
     dvec3 pixelDown{0.0};
 
+    // SPEC §3: eye (0, 0, 1) looking at the origin, y up, the image plane
+    // [-halfWidth, halfWidth]² at distance 1.
     static Camera fromSpec(int imageSize, double halfWidth);
+    // A general pinhole camera: from `eye` towards `target`, `up` giving the
+    // image's vertical, the image plane at unit distance with half-width
+    // `halfWidth`. fromSpec is lookAt((0,0,1), (0,0,0), (0,1,0), ...), exactly.
+    static Camera lookAt(const dvec3& eye, const dvec3& target, const dvec3& up, double halfWidth, int width,
+                         int height);
     dvec3 direction(double x, double y) const {
         return glm::normalize(cornerDir + x * pixelRight + y * pixelDown);
     }

@@ -445,6 +445,11 @@ void Context::destroy(Buffer& b) {
 }
 
 StorageImage Context::createStorageImage(std::uint32_t width, std::uint32_t height, VkFormat format) {
+    return createImage(width, height, format, VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT);
+}
+
+StorageImage Context::createImage(std::uint32_t width, std::uint32_t height, VkFormat format,
+                                  VkImageUsageFlags usage) {
     StorageImage img;
     img.width = width;
     img.height = height;
@@ -456,7 +461,7 @@ StorageImage Context::createStorageImage(std::uint32_t width, std::uint32_t heig
     info.arrayLayers = 1;
     info.samples = VK_SAMPLE_COUNT_1_BIT;
     info.tiling = VK_IMAGE_TILING_OPTIMAL;
-    info.usage = VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
+    info.usage = usage;
     info.initialLayout = VK_IMAGE_LAYOUT_UNDEFINED;
     try {
         check(vkCreateImage(device_, &info, nullptr, &img.image), "vkCreateImage");
@@ -467,12 +472,14 @@ StorageImage Context::createStorageImage(std::uint32_t width, std::uint32_t heig
         alloc.memoryTypeIndex = findMemoryType(req.memoryTypeBits, 0, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
         check(allocate(alloc, &img.memory), "vkAllocateMemory");
         check(vkBindImageMemory(device_, img.image, img.memory, 0), "vkBindImageMemory");
-        VkImageViewCreateInfo view{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
-        view.image = img.image;
-        view.viewType = VK_IMAGE_VIEW_TYPE_2D;
-        view.format = format;
-        view.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
-        check(vkCreateImageView(device_, &view, nullptr, &img.view), "vkCreateImageView");
+        if (usage & (VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT)) {
+            VkImageViewCreateInfo view{VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO};
+            view.image = img.image;
+            view.viewType = VK_IMAGE_VIEW_TYPE_2D;
+            view.format = format;
+            view.subresourceRange = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1};
+            check(vkCreateImageView(device_, &view, nullptr, &img.view), "vkCreateImageView");
+        }
     } catch (...) {
         destroy(img);
         throw;

@@ -110,6 +110,8 @@ public:
     Buffer createBufferWithData(const void* bytes, VkDeviceSize size, VkBufferUsageFlags usage);
     void destroy(Buffer& buffer);
     StorageImage createStorageImage(std::uint32_t width, std::uint32_t height, VkFormat format);
+    // A device-local 2D image with a view, for any usage.
+    StorageImage createImage(std::uint32_t width, std::uint32_t height, VkFormat format, VkImageUsageFlags usage);
     void destroy(StorageImage& image);
 
     // vkQueueSubmit on the context's queue (through the fault-injection hook).
