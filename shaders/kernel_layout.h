@@ -32,7 +32,16 @@ struct IntersectCase {
     uint pad0;
 };
 
+// The device's ceiling (issue 5's micro-kernel, ray_sphere_kernel.comp): one
+// ray per invocation against SNELL_CEILING_SPHERES spheres.
+#define SNELL_CEILING_SPHERES 64
+struct CeilingSphere {
+    vec4 centreRadius;     // centre + radius form
+    mat4 objectFromWorld;  // inverse-matrix form
+};
+
 #ifdef __cplusplus
+static_assert(sizeof(CeilingSphere) == 80);
 static_assert(sizeof(IntersectCase) == 272 && offsetof(IntersectCase, kind) == 256);
 }  // namespace snell::gpu
 #endif

@@ -19,6 +19,7 @@
 #include <CLI/CLI.hpp>
 
 #include "gpu/ComputeRenderer.h"
+#include "bench/Bench.h"
 #include "preview/Preview.h"
 #include "image/ImageIO.h"
 #include "metrics/ImageMetrics.h"
@@ -101,6 +102,16 @@ private:
     std::mutex mutex_;
     Clock::time_point last_{};
 };
+
+// Compiled pipelines persist here between runs: $SNELL_CACHE_DIR, else
+// $XDG_CACHE_HOME/snell, else ~/.cache/snell; empty (no cache) if none is set.
+std::string pipelineCachePath() {
+    std::string dir;
+    if (const char* d = std::getenv("SNELL_CACHE_DIR"); d && *d) dir = d;
+    else if (const char* x = std::getenv("XDG_CACHE_HOME"); x && *x) dir = std::string(x) + "/snell";
+    else if (const char* h = std::getenv("HOME"); h && *h) dir = std::string(h) + "/.cache/snell";
+    return dir.empty() ? std::string() : dir + "/pipelines.bin";
+}
 
 int runRender(const RenderOptions& o) {
     const auto totalStart = Clock::now();
@@ -189,6 +200,7 @@ int runRender(const RenderOptions& o) {
             options.deviceIndex = o.gpu;
             options.validation = o.validation;
             options.fault = o.fault;
+            options.pipelineCachePath = pipelineCachePath();
             snell::vk::Context context(options);
             device = context.deviceName();
             snell::ComputeRenderer renderer(
@@ -287,6 +299,26 @@ int runPreviewCommand(const snell::PreviewOptions& o) {
     return gInterrupted.load() ? kExitInterrupted : 0;
 }
 
+int runBenchCommand(snell::BenchOptions o) {
+    namespace fs = std::filesystem;
+    // The repository: the working directory when it has scenes/, else where snell was built from.
+    if (o.sourceDir.empty()) o.sourceDir = fs::exists("scenes") && fs::exists("bench") ? "." : SNELL_SOURCE_DIR;
+    if (o.sharedDir.empty()) o.sharedDir = (fs::path(o.sourceDir) / ".." / "shared").string();
+    std::error_code ec;
+    o.snellPath = fs::read_symlink("/proc/self/exe", ec).string();
+    try {
+        snell::runBench(o, std::cerr);
+    } catch (const snell::ParseError& e) {
+        std::cerr << e.what() << "\n";
+        return kExitInput;
+    } catch (const std::exception& e) {
+        if (gInterrupted.load()) return kExitInterrupted;
+        std::cerr << "snell: error: " << e.what() << "\n";
+        return kExitRuntime;
+    }
+    return 0;
+}
+
 int runDevices() {
     try {
         const auto reports = snell::vk::Context::listDevices();
@@ -372,6 +404,18 @@ int main(int argc, char** argv) {
     preview->add_option("--screenshot", po.screenshot, "Scripted: the PNG to save after --frames frames")->needs(frames);
     preview->add_option("--orbit", po.orbitDegrees, "Scripted: orbit the camera by DEGREES before the first frame");
 
+    snell::BenchOptions bo;
+    bo.cancel = &gInterrupted;
+    CLI::App* bench = app.add_subcommand("bench", "Speed against error: sweep settings, compare with peers, write CSV/JSON/SVG");
+    bench->add_option("scenes", bo.scenes, "Scene files or directories (default: scenes/, scenes/hard/, the course and bench scenes)");
+    bench->add_flag("--quick", bo.quick, "A small, fast run (CI): scenes/ and the bench scenes at 48x48, fewer settings");
+    bench->add_option("-s,--size", bo.size, "Image size (default 128; quick 48)")->check(CLI::Range(8, 4096));
+    bench->add_option("--runs", bo.runs, "Timed runs per setting after a warm-up (at least 5)")->check(CLI::Range(5, 1000));
+    bench->add_option("-o,--out", bo.outDir, "Directory for bench.csv, bench.json, bench.svg (default bench/results)");
+    bench->add_option("--source-dir", bo.sourceDir, "The snell repository (default: . if it has scenes/, else the build's)");
+    bench->add_option("--shared-dir", bo.sharedDir, "Where course-scenes/ and bench-scenes/ are (default SOURCE/../shared)");
+    bench->add_option("--gpu", bo.gpu, "Vulkan device index")->envname("SNELL_GPU")->check(CLI::NonNegativeNumber);
+
     std::string compareA, compareB, compareDiff;
     int compareThreshold = 3;
     CLI::App* compare = app.add_subcommand("compare", "Error metrics of image A against reference B, as JSON (8-bit units)");
@@ -408,8 +452,10 @@ int main(int argc, char** argv) {
         }
     }
     if (render->parsed()) return runRender(ro);
+    if (bench->parsed()) return runBenchCommand(bo);
     if (preview->parsed()) {
         po.precision = previewPrecision == "fp64" ? snell::gpu::Precision::Fp64 : snell::gpu::Precision::Fp32;
+        po.pipelineCachePath = pipelineCachePath();
         return runPreviewCommand(po);
     }
     if (app.got_subcommand("devices")) return runDevices();

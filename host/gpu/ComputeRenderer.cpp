@@ -48,14 +48,14 @@ struct ComputeRenderer::Pipeline {
 };
 
 ComputeRenderer::ComputeRenderer(vk::Context& context, const Scene& scene, const Camera& camera,
-                                 gpu::Precision precision)
+                                 gpu::Precision precision, gpu::BvhMode bvh)
     : context_(context), scene_(scene) {
     if (precision == gpu::Precision::Fp64 && !context.float64Supported())
         throw vk::VulkanError("--precision fp64 needs shader doubles (the shaderFloat64 feature), which " +
                               std::string(context.properties().deviceName) +
                               " lacks; use --precision fp32, or another device (--gpu; lavapipe has them)");
     const auto start = Clock::now();
-    layout_ = gpu::buildGpuScene(scene, camera, precision);
+    layout_ = gpu::buildGpuScene(scene, camera, precision, bvh);
     const VkDeviceSize limit = context.properties().limits.maxStorageBufferRange;
     auto upload = [&](const auto& v, const char* what) {
         const VkDeviceSize bytes = v.size() * sizeof(v[0]);
@@ -163,7 +163,7 @@ void ComputeRenderer::createPipeline(const Specialisation& values, Pipeline& p) 
     pipelineInfo.stage.pName = "main";
     pipelineInfo.stage.pSpecializationInfo = &spec;
     pipelineInfo.layout = p.layout;
-    check(vkCreateComputePipelines(device, VK_NULL_HANDLE, 1, &pipelineInfo, nullptr, &p.pipeline),
+    check(vkCreateComputePipelines(device, context_.pipelineCache(), 1, &pipelineInfo, nullptr, &p.pipeline),
           "vkCreateComputePipelines");
 
     const std::uint32_t uniformBuffers = wide ? 2 : 1;

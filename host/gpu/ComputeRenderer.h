@@ -30,7 +30,7 @@ public:
     // Uploads the scene; `camera.eye` becomes the GPU's coordinate origin.
     // Fp64 needs the device's shaderFloat64 feature (else vk::VulkanError).
     ComputeRenderer(vk::Context& context, const Scene& scene, const Camera& camera,
-                    gpu::Precision precision = gpu::Precision::Fp32);
+                    gpu::Precision precision = gpu::Precision::Fp32, gpu::BvhMode bvh = gpu::BvhMode::Auto);
     ~ComputeRenderer();
     ComputeRenderer(const ComputeRenderer&) = delete;
     ComputeRenderer& operator=(const ComputeRenderer&) = delete;

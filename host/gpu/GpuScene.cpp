@@ -64,7 +64,7 @@ double primaryStartDistance(const snell::Scene& scene, const snell::dvec3& eye) 
     return std::max(0.0, nearest - margin);
 }
 
-GpuScene buildGpuScene(const snell::Scene& scene, const snell::Camera& camera, Precision precision) {
+GpuScene buildGpuScene(const snell::Scene& scene, const snell::Camera& camera, Precision precision, BvhMode bvh) {
     GpuScene out;
     out.precision = precision;
     const bool wide = precision == Precision::Fp64;
@@ -79,7 +79,10 @@ GpuScene buildGpuScene(const snell::Scene& scene, const snell::Camera& camera, P
 
     std::vector<std::uint32_t> order(scene.spheres.size());
     for (std::uint32_t i = 0; i < order.size(); ++i) order[i] = i;
-    if (scene.spheres.size() > kBvhThreshold) {
+    const bool useBvh = bvh == BvhMode::On ? scene.spheres.size() > 1
+                        : bvh == BvhMode::Off ? false
+                                              : scene.spheres.size() > kBvhThreshold;
+    if (useBvh) {
         const auto start = std::chrono::steady_clock::now();
         std::vector<snell::Aabb> bounds;
         bounds.reserve(scene.spheres.size());

@@ -33,6 +33,8 @@ enum class Precision { Fp32, Fp64 };
 
 // Spheres above this count are traversed through the BVH; fewer are tested in a loop.
 inline constexpr std::size_t kBvhThreshold = 8;
+// Whether to build and traverse a BVH: by that threshold, or forced (the bench).
+enum class BvhMode { Auto, Off, On };
 
 struct GpuScene {
     std::vector<Sphere> spheres;
@@ -56,7 +58,7 @@ struct GpuScene {
 };
 
 GpuScene buildGpuScene(const snell::Scene& scene, const snell::Camera& camera,
-                       Precision precision = Precision::Fp32);
+                       Precision precision = Precision::Fp32, BvhMode bvh = BvhMode::Auto);
 
 // How far primary rays from `eye` can go before they could meet any sphere.
 double primaryStartDistance(const snell::Scene& scene, const snell::dvec3& eye);

@@ -295,6 +295,7 @@ void Session::run() {
     vk::ContextOptions options;
     options.deviceIndex = o_.gpu;
     options.validation = o_.validation;
+    options.pipelineCachePath = o_.pipelineCachePath;
     for (std::uint32_t i = 0; i < count; ++i) options.instanceExtensions.push_back(required[i]);
     options.deviceExtensions.push_back(VK_KHR_SWAPCHAIN_EXTENSION_NAME);
     context_ = std::make_unique<vk::Context>(options);

@@ -33,6 +33,7 @@ struct PreviewOptions {
     std::string screenshot;
     double orbitDegrees = 0.0;
     const std::atomic<bool>* cancel = nullptr;  // set to close the window
+    std::string pipelineCachePath;              // vk::ContextOptions::pipelineCachePath
 };
 
 // No window could be opened (no display, no GLFW Vulkan support, ...).

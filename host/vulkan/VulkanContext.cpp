@@ -3,6 +3,11 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+
+#include <unistd.h>
 
 namespace snell::vk {
 
@@ -322,6 +327,23 @@ Context::Context(const ContextOptions& options) : fault_(options.fault) {
         check(vkCreateCommandPool(device_, &poolInfo, nullptr, &pool_), "vkCreateCommandPool");
         VkFenceCreateInfo fenceInfo{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
         check(vkCreateFence(device_, &fenceInfo, nullptr, &fence_), "vkCreateFence");
+
+        // The pipeline cache: what earlier runs compiled, when the file holds
+        // data for this device and driver (the driver checks and ignores any other).
+        pipelineCachePath_ = options.pipelineCachePath;
+        std::vector<char> initial;
+        if (!pipelineCachePath_.empty()) {
+            std::ifstream in(pipelineCachePath_, std::ios::binary);
+            initial.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+        }
+        VkPipelineCacheCreateInfo cacheInfo{VK_STRUCTURE_TYPE_PIPELINE_CACHE_CREATE_INFO};
+        cacheInfo.initialDataSize = initial.size();
+        cacheInfo.pInitialData = initial.empty() ? nullptr : initial.data();
+        if (vkCreatePipelineCache(device_, &cacheInfo, nullptr, &pipelineCache_) != VK_SUCCESS) {
+            cacheInfo.initialDataSize = 0;  // unreadable data: start empty
+            cacheInfo.pInitialData = nullptr;
+            check(vkCreatePipelineCache(device_, &cacheInfo, nullptr, &pipelineCache_), "vkCreatePipelineCache");
+        }
     } catch (...) {
         release();
         throw;
@@ -330,9 +352,36 @@ Context::Context(const ContextOptions& options) : fault_(options.fault) {
 
 Context::~Context() { release(); }
 
+void Context::savePipelineCache() {
+    // Best effort: a cache that cannot be written only makes the next start slower.
+    std::size_t size = 0;
+    if (vkGetPipelineCacheData(device_, pipelineCache_, &size, nullptr) != VK_SUCCESS || size == 0) return;
+    std::vector<char> data(size);
+    if (vkGetPipelineCacheData(device_, pipelineCache_, &size, data.data()) != VK_SUCCESS) return;
+    std::error_code ignored;
+    const std::filesystem::path path(pipelineCachePath_);
+    std::filesystem::create_directories(path.parent_path(), ignored);
+    const std::string temporary = pipelineCachePath_ + ".tmp-" + std::to_string(::getpid());
+    {
+        std::ofstream out(temporary, std::ios::binary);
+        out.write(data.data(), std::streamsize(size));
+        if (!out) {
+            std::filesystem::remove(temporary, ignored);
+            return;
+        }
+    }
+    std::filesystem::rename(temporary, path, ignored);  // atomic: concurrent runs never see half a file
+    if (ignored) std::filesystem::remove(temporary, ignored);
+}
+
 void Context::release() {
     if (device_) {
         vkDeviceWaitIdle(device_);
+        if (pipelineCache_) {
+            if (!pipelineCachePath_.empty()) savePipelineCache();
+            vkDestroyPipelineCache(device_, pipelineCache_, nullptr);
+            pipelineCache_ = VK_NULL_HANDLE;
+        }
         if (fence_) vkDestroyFence(device_, fence_, nullptr);
         if (pool_) vkDestroyCommandPool(device_, pool_, nullptr);
         vkDestroyDevice(device_, nullptr);

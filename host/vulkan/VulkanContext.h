@@ -53,6 +53,9 @@ struct ContextOptions {
     std::vector<std::string> instanceExtensions;  // e.g. what GLFW needs
     std::vector<std::string> deviceExtensions;
     FaultInjection fault;
+    // Where compiled pipelines are kept between runs (read at start, written
+    // back at the end); empty: no cache on disk.
+    std::string pipelineCachePath;
 };
 
 struct DeviceReport {
@@ -114,6 +117,9 @@ public:
     StorageImage createImage(std::uint32_t width, std::uint32_t height, VkFormat format, VkImageUsageFlags usage);
     void destroy(StorageImage& image);
 
+    // The pipeline cache (VK_NULL_HANDLE when none could be made).
+    VkPipelineCache pipelineCache() const { return pipelineCache_; }
+
     // vkQueueSubmit on the context's queue (through the fault-injection hook).
     VkResult submit(const VkSubmitInfo& info, VkFence fence);
 
@@ -158,6 +164,9 @@ private:
     std::vector<DeviceReport> reports_;
     std::uint32_t validationMessages_ = 0;
     FaultInjection fault_;
+    VkPipelineCache pipelineCache_ = VK_NULL_HANDLE;
+    std::string pipelineCachePath_;
+    void savePipelineCache();
     std::uint32_t submissions_ = 0, allocations_ = 0;
 };
 

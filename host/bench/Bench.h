@@ -1,0 +1,40 @@
+// `snell bench` (issue 5): speed against error. For each scene it sweeps the
+// renderer's settings (depth, weight cut-off, precision, BVH, supersampling),
+// times the dispatches by GPU timestamps (median and range of several runs
+// after a warm-up), measures the error against the converged CPU reference,
+// and records the peers of the same run: the CPU reference itself, POV-Ray
+// 3.7 on the shared bench scenes, the device's ray–sphere ceiling, and the
+// render time against sphere count. Writes bench.csv, bench.json, bench.svg.
+#pragma once
+
+#include <atomic>
+#include <ostream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace snell {
+
+struct BenchOptions {
+    std::vector<std::string> scenes;  // files or directories; empty: the default set
+    bool quick = false;               // fewer settings, smaller images (CI)
+    int size = 0;                     // image side; 0: 256 (quick: 48)
+    int runs = 5;                     // timed runs per setting, after one warm-up
+    std::string outDir = "bench/results";
+    std::string sourceDir;            // the repository (scenes/, bench/make_scaling_scene.py)
+    std::string sharedDir;            // ../shared (course and bench scenes)
+    std::string snellPath;            // this executable, for whole-command timings
+    int gpu = -1;
+    const std::atomic<bool>* cancel = nullptr;
+};
+
+class BenchError : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
+// Runs the benchmark, logging progress to `log`. Throws BenchError,
+// vk::VulkanError, ParseError (a scene of the set), ImageIOError.
+void runBench(const BenchOptions& options, std::ostream& log);
+
+}  // namespace snell
