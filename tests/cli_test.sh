@@ -89,5 +89,18 @@ done
 SNELL_INJECT_FAULT=cosmic-ray "$SNELL" render "$SCENES/basic.scn" -o "$work/x.png" 2>"$work/err"; status=$?
 [ $status -eq 2 ] && grep -q "unknown fault" "$work/err" && ok || bad "bad SNELL_INJECT_FAULT ($status)"
 
+# -o - streams PPM to standard output (and --stats moves to standard error).
+"$SNELL" render "$SCENES/basic.scn" --size 16 -o - -q --stats >"$work/pipe.ppm" 2>"$work/err"; status=$?
+[ $status -eq 0 ] && [ "$(head -c 2 "$work/pipe.ppm")" = "P6" ] && [ "$(wc -c <"$work/pipe.ppm")" -eq $((13 + 16 * 16 * 3)) ] &&
+  grep -q '"output": "-"' "$work/err" && ok || bad "-o - (status $status): $(head -c 100 "$work/err")"
+
+# check: statistics on stdout, warnings (unclosed group, light inside an opaque sphere) on stderr, status 0; errors 2.
+printf 'view 64 0.5\nlight 1 1 1 0 0 -3\ngroup\nmaterial 1 1 1 0 0 0 1\nmove 0 0 -3\nsphere\n' >"$work/warn.scn"
+"$SNELL" check "$work/warn.scn" --json >"$work/check" 2>"$work/err"; status=$?
+[ $status -eq 0 ] && python3 -c 'import json,sys; d=json.load(open(sys.argv[1])); assert d["spheres"] == 1 and d["true_spheres"] == 1 and d["lights"] == 1 and len(d["warnings"]) == 2' "$work/check" &&
+  grep -q "warn.scn:3:1: warning: 'group' is never closed" "$work/err" && grep -q "warn.scn:6:1: warning: light 1 .* inside" "$work/err" &&
+  ok || bad "check (status $status): $(cat "$work/check" "$work/err")"
+"$SNELL" check "$work/bad.scn" >/dev/null 2>"$work/err"; [ $? -eq 2 ] && grep -q "bad.scn:3:9: error" "$work/err" && ok || bad "check of a bad scene"
+
 echo "cli: $pass passed, $fail failed"
 [ $fail -eq 0 ]

@@ -20,6 +20,7 @@
 
 #include "gpu/ComputeRenderer.h"
 #include "bench/Bench.h"
+#include "check/SceneCheck.h"
 #include "preview/Preview.h"
 #include "image/ImageIO.h"
 #include "metrics/ImageMetrics.h"
@@ -246,6 +247,8 @@ int runRender(const RenderOptions& o) {
     }
     writeMs += msSince(commitStart);
     if (o.stats) {
+        // With the image on standard output, the statistics go to standard error.
+        std::ostream& statsOut = output == snell::kStandardOutput ? std::cerr : std::cout;
         std::ostringstream j;
         j.precision(6);
         j << std::fixed << "{\"scene\": " << jsonString(o.scene) << ", \"output\": " << jsonString(output)
@@ -263,7 +266,7 @@ int runRender(const RenderOptions& o) {
           << ", \"total_ms\": " << msSince(totalStart) << ", \"rays\": {\"primary\": " << rays.primary
           << ", \"shadow\": " << rays.shadow << ", \"reflected\": " << rays.reflected
           << ", \"refracted\": " << rays.refracted << ", \"total\": " << rays.total() << "}}";
-        std::cout << j.str() << std::endl;
+        statsOut << j.str() << std::endl;
     }
     return 0;
 }
@@ -319,6 +322,21 @@ int runBenchCommand(snell::BenchOptions o) {
     return 0;
 }
 
+// Statistics on standard output, warnings on standard error; status 2 on errors.
+int runCheck(const std::string& path, bool json) {
+    snell::Scene scene;
+    try {
+        scene = snell::parseSceneFile(path);
+    } catch (const snell::ParseError& e) {
+        std::cerr << e.what() << "\n";
+        return kExitInput;
+    }
+    const snell::SceneReport report = snell::checkScene(scene, path);
+    for (const snell::Diagnostic& w : report.warnings) std::cerr << w.format("warning") << "\n";
+    std::cout << (json ? report.json(scene) + "\n" : report.text(scene));
+    return 0;
+}
+
 int runDevices() {
     try {
         const auto reports = snell::vk::Context::listDevices();
@@ -360,7 +378,7 @@ int main(int argc, char** argv) {
     RenderOptions ro;
     CLI::App* render = app.add_subcommand("render", "Render a scene file to an image (PNG, PPM or PFM by extension)");
     render->add_option("scene", ro.scene, "Scene file")->required();
-    render->add_option("-o,--output", ro.output, "Output image: .png, .ppm (P6) or .pfm (float); default SCENE.png");
+    render->add_option("-o,--output", ro.output, "Output image: .png, .ppm (P6) or .pfm (float); - for PPM on standard output; default SCENE.png");
     render->add_flag("--cpu", ro.cpu, "Render with the double-precision CPU reference instead of the GPU");
     render->add_option("-s,--size", ro.size, "Image size in pixels (overrides the scene's view n)")
         ->check(CLI::Range(1, snell::ParseLimits::kMaxImageSize));
@@ -416,6 +434,12 @@ int main(int argc, char** argv) {
     bench->add_option("--shared-dir", bo.sharedDir, "Where course-scenes/ and bench-scenes/ are (default SOURCE/../shared)");
     bench->add_option("--gpu", bo.gpu, "Vulkan device index")->envname("SNELL_GPU")->check(CLI::NonNegativeNumber);
 
+    std::string checkScene;
+    bool checkJson = false;
+    CLI::App* check = app.add_subcommand("check", "Parse a scene and report what it holds and what looks wrong, without rendering");
+    check->add_option("scene", checkScene, "Scene file")->required();
+    check->add_flag("--json", checkJson, "One JSON object on standard output");
+
     std::string compareA, compareB, compareDiff;
     int compareThreshold = 3;
     CLI::App* compare = app.add_subcommand("compare", "Error metrics of image A against reference B, as JSON (8-bit units)");
@@ -453,6 +477,7 @@ int main(int argc, char** argv) {
     }
     if (render->parsed()) return runRender(ro);
     if (bench->parsed()) return runBenchCommand(bo);
+    if (check->parsed()) return runCheck(checkScene, checkJson);
     if (preview->parsed()) {
         po.precision = previewPrecision == "fp64" ? snell::gpu::Precision::Fp64 : snell::gpu::Precision::Fp32;
         po.pipelineCachePath = pipelineCachePath();

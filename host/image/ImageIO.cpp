@@ -132,6 +132,7 @@ private:
 }  // namespace
 
 ImageFormat formatForPath(const std::string& path) {
+    if (path == kStandardOutput) return ImageFormat::Ppm;
     const std::string ext = extensionOf(path);
     if (ext == ".png") return ImageFormat::Png;
     if (ext == ".ppm") return ImageFormat::Ppm;
@@ -141,6 +142,7 @@ ImageFormat formatForPath(const std::string& path) {
 }
 
 void checkWritable(const std::string& path) {
+    if (path == kStandardOutput) return;
     formatForPath(path);
     fs::path p(path);
     if (fs::is_directory(p)) throw ImageIOError("output '" + path + "' is a directory");
@@ -157,6 +159,10 @@ void checkWritable(const std::string& path) {
 
 ImageWriter::ImageWriter(std::string path, int width, int height)
     : path_(std::move(path)), width_(width), height_(height) {
+    if (path_ == kStandardOutput) {  // a pipe: rows go out as they come
+        file_ = stdout;
+        return;
+    }
     // A unique temporary name in the same directory, so rename() is atomic.
     std::random_device random;
     temporary_ = path_ + ".tmp-" + std::to_string(::getpid()) + "-" + std::to_string(random());
@@ -165,6 +171,10 @@ ImageWriter::ImageWriter(std::string path, int width, int height)
 }
 
 ImageWriter::~ImageWriter() {
+    if (path_ == kStandardOutput) {
+        std::fflush(stdout);
+        return;
+    }
     if (file_) std::fclose(file_);
     if (!committed_) std::remove(temporary_.c_str());
 }
@@ -184,6 +194,11 @@ void ImageWriter::commit() {
         throw ImageIOError("internal error: " + std::to_string(rowsWritten_) + " of " + std::to_string(height_) +
                            " rows written to '" + path_ + "'");
     finish();
+    if (path_ == kStandardOutput) {
+        if (std::fflush(stdout) != 0) throw ImageIOError("cannot write to standard output: " + errorText());
+        committed_ = true;
+        return;
+    }
     const bool flushed = std::fflush(file_) == 0 && ::fsync(fileno(file_)) == 0;
     const int closed = std::fclose(file_);
     file_ = nullptr;

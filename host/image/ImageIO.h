@@ -23,6 +23,11 @@ public:
 
 enum class ImageFormat { Png, Ppm, Pfm };
 
+// "-" as a path: standard output, as PPM (for pipes). Rows stream out as they
+// finish; a failed render there ends the stream early (and the exit status
+// says so), since a pipe cannot be taken back.
+inline const std::string kStandardOutput = "-";
+
 // The format for a path's extension; throws ImageIOError for anything else.
 ImageFormat formatForPath(const std::string& path);
 
