@@ -44,6 +44,10 @@ struct FaultInjection {
     std::uint32_t at = 1;  // the Nth submission or allocation, from 1
 };
 
+// A layout transition of a whole single-level colour image.
+void imageBarrier(VkCommandBuffer cmd, VkImage image, VkImageLayout from, VkImageLayout to, VkAccessFlags srcAccess,
+                  VkAccessFlags dstAccess, VkPipelineStageFlags srcStage, VkPipelineStageFlags dstStage);
+
 // "device-lost[:N]" or "out-of-device-memory[:N]"; throws std::invalid_argument.
 FaultInjection parseFaultInjection(const std::string& text);
 
