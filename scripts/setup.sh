@@ -6,7 +6,7 @@ cd "$(dirname "$0")/.."
 
 packages=(cmake ninja-build g++ pkg-config
           libvulkan-dev mesa-vulkan-drivers vulkan-tools vulkan-validationlayers
-          glslang-tools libglm-dev libglfw3-dev libstb-dev libpng-dev libcli11-dev libgtest-dev
+          glslang-tools libglm-dev libglfw3-dev libstb-dev libpng-dev libtinyexr-dev libcli11-dev libgtest-dev
           clang-14 libclang-rt-14-dev xvfb povray python3)
 missing=()
 for p in "${packages[@]}"; do

@@ -33,7 +33,7 @@ grep -q "^$work/bad.scn:3:9: error: " "$work/err" && ok || bad "error format: $(
 # Bad command line: status 2. Unknown output format / unwritable dir: status 1 before rendering.
 "$SNELL" render "$SCENES/basic.scn" --size 0 -o "$work/x.png" 2>/dev/null; [ $? -eq 2 ] && ok || bad "--size 0"
 "$SNELL" render "$SCENES/basic.scn" -o "$work/x.jpg" 2>"$work/err"; status=$?
-[ $status -eq 1 ] && grep -q ".png, .ppm or .pfm" "$work/err" && ok || bad "unknown extension ($status)"
+[ $status -eq 1 ] && grep -q ".png, .ppm, .pfm or .exr" "$work/err" && ok || bad "unknown extension ($status)"
 "$SNELL" render "$SCENES/basic.scn" -o "$work/no/such/dir/x.png" 2>"$work/err"; status=$?
 [ $status -eq 1 ] && grep -q "does not exist" "$work/err" && ok || bad "missing output dir ($status)"
 
@@ -61,7 +61,12 @@ head -c 2 "$work/basic.pfm" | grep -q PF && ok || bad "PFM magic"
 
 # The CPU back end renders the same scene, and compare agrees with itself.
 "$SNELL" render "$SCENES/basic.scn" --size 32 --cpu -o "$work/cpu.png" 2>/dev/null && ok || bad "--cpu"
-"$SNELL" compare "$work/basic.png" "$work/cpu.png" >"$work/cmp" && grep -q mean_abs_error "$work/cmp" && ok || bad "compare"
+"$SNELL" compare --json "$work/basic.png" "$work/cpu.png" >"$work/cmp" && grep -q mean_abs_error "$work/cmp" && ok || bad "compare --json"
+"$SNELL" compare "$work/basic.png" "$work/basic.png" --diff "$work/diff.png" >"$work/cmp" &&
+  grep -q "mean abs error 0.0000/255" "$work/cmp" && [ -s "$work/diff.png" ] && ok || bad "compare (text, --diff): $(cat "$work/cmp")"
+# EXR: written, read back by compare, equal to the PFM of the same render.
+"$SNELL" render "$SCENES/basic.scn" --size 32 -o "$work/basic.exr" -q && "$SNELL" compare --json "$work/basic.exr" "$work/basic.pfm" |
+  grep -q '"max_error": 0' && ok || bad "EXR output"
 
 # Ctrl-C during a long render: status 130, no output file, no temporary left.
 "$SNELL" render "$SCENES/showcase.scn" --size 4096 --cpu -o "$work/interrupted.png" 2>/dev/null &

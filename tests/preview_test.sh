@@ -34,13 +34,13 @@ scene="$SCENES/showcase.scn"
 [ $status -eq 0 ] && [ -s "$work/shot.png" ] && ok || bad "scripted preview (status $status): $(cat "$work/err")"
 grep -q "validation" "$work/err" && bad "validation layer messages: $(cat "$work/err")" || ok
 "$SNELL" render "$scene" --size 128 -q -o "$work/render.png" && ok || bad "render"
-"$SNELL" compare "$work/shot.png" "$work/render.png" >"$work/cmp" && within_thresholds <"$work/cmp" && ok ||
+"$SNELL" compare --json "$work/shot.png" "$work/render.png" >"$work/cmp" && within_thresholds <"$work/cmp" && ok ||
   bad "screenshot differs from the render: $(cat "$work/cmp")"
 
 # An orbit changes the image.
 "$SNELL" preview "$scene" --size 128 --frames 4 --orbit 40 --screenshot "$work/orbit.png" 2>"$work/err"; status=$?
 [ $status -eq 0 ] && ok || bad "orbit preview (status $status): $(cat "$work/err")"
-"$SNELL" compare "$work/orbit.png" "$work/render.png" >"$work/cmp" &&
+"$SNELL" compare --json "$work/orbit.png" "$work/render.png" >"$work/cmp" &&
   python3 -c 'import json,sys; d=json.load(sys.stdin); sys.exit(0 if d["mean_abs_error"] > 1 else 1)' <"$work/cmp" && ok ||
   bad "the orbit did not change the image: $(cat "$work/cmp")"
 

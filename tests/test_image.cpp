@@ -189,10 +189,25 @@ TEST_F(ImageFiles, ExistingFileReplacedOnlyOnSuccess) {
     EXPECT_THROW(snell::checkWritable(asDir), ImageIOError);
 }
 
+TEST_F(ImageFiles, ExrRoundTripIsExactAndUnclamped) {
+    Image image(3, 2);
+    const float values[18] = {3.5f, -2.25f, 1e-7f, 1e30f, 0.0f, -0.0f, 1.0f / 3.0f, 255.75f, -1e-20f,
+                              0.5f, 7.0f, 1.0f, 2.0f, 3.0f, 4.0f, 5.0f, 6.0f, -7.0f};
+    std::copy(values, values + 18, image.rgb.begin());
+    snell::writeImage(path("f.exr"), image);
+    EXPECT_EQ(slurp(path("f.exr")).substr(0, 4), std::string("\x76\x2f\x31\x01"));  // OpenEXR magic
+    const Image back = snell::readImage(path("f.exr"));
+    ASSERT_EQ(back.width, 3);
+    ASSERT_EQ(back.height, 2);
+    for (int i = 0; i < 18; ++i) EXPECT_EQ(back.rgb[i], values[i]) << i;
+}
+
 TEST(ImageFormat, ByExtension) {
     EXPECT_EQ(snell::formatForPath("a.png"), snell::ImageFormat::Png);
     EXPECT_EQ(snell::formatForPath("dir.x/a.ppm"), snell::ImageFormat::Ppm);
     EXPECT_EQ(snell::formatForPath("a.pfm"), snell::ImageFormat::Pfm);
+    EXPECT_EQ(snell::formatForPath("a.exr"), snell::ImageFormat::Exr);
+    EXPECT_EQ(snell::formatForPath("-"), snell::ImageFormat::Ppm);
     EXPECT_EQ(snell::formatForPath("A.PNG"), snell::ImageFormat::Png);
     EXPECT_THROW(snell::formatForPath("a.jpg"), ImageIOError);
     EXPECT_THROW(snell::formatForPath("a.png.jpg"), ImageIOError);

@@ -271,13 +271,22 @@ int runRender(const RenderOptions& o) {
     return 0;
 }
 
-int runCompare(const std::string& a, const std::string& b, const std::string& diff, int threshold) {
+int runCompare(const std::string& a, const std::string& b, const std::string& diff, int threshold, bool json) {
     try {
         const snell::Image test = snell::readImage(a);
         const snell::Image reference = snell::readImage(b);
         const snell::ImageMetrics m = snell::compareImages(test, reference, threshold);
         if (!diff.empty()) snell::writeImage(diff, snell::differenceImage(test, reference));
-        std::cout << m.json() << std::endl;
+        if (json) {
+            std::cout << m.json() << std::endl;
+        } else {
+            std::printf("mean abs error %.4f/255, RMSE %.4f/255, PSNR %.2f dB, max %d/255\n"
+                        "bad pixels (> %d/255) %llu of %llu (%.4f%%), isolated speckles %llu, NaN/Inf %llu\n",
+                        m.meanAbsError, m.rmse, m.psnr, m.maxError, threshold,
+                        static_cast<unsigned long long>(m.badPixels), static_cast<unsigned long long>(m.pixels),
+                        100.0 * m.badFraction, static_cast<unsigned long long>(m.speckles),
+                        static_cast<unsigned long long>(m.nonFinite));
+        }
     } catch (const std::exception& e) {
         std::cerr << "snell: error: " << e.what() << "\n";
         return kExitRuntime;
@@ -376,9 +385,9 @@ int main(int argc, char** argv) {
     app.add_flag("--version", version, "Print the version and the Vulkan device snell would use");
 
     RenderOptions ro;
-    CLI::App* render = app.add_subcommand("render", "Render a scene file to an image (PNG, PPM or PFM by extension)");
+    CLI::App* render = app.add_subcommand("render", "Render a scene file to an image (PNG, PPM, PFM or EXR by extension)");
     render->add_option("scene", ro.scene, "Scene file")->required();
-    render->add_option("-o,--output", ro.output, "Output image: .png, .ppm (P6) or .pfm (float); - for PPM on standard output; default SCENE.png");
+    render->add_option("-o,--output", ro.output, "Output image: .png, .ppm (P6), .pfm or .exr (float); - for PPM on standard output; default SCENE.png");
     render->add_flag("--cpu", ro.cpu, "Render with the double-precision CPU reference instead of the GPU");
     render->add_option("-s,--size", ro.size, "Image size in pixels (overrides the scene's view n)")
         ->check(CLI::Range(1, snell::ParseLimits::kMaxImageSize));
@@ -442,11 +451,13 @@ int main(int argc, char** argv) {
 
     std::string compareA, compareB, compareDiff;
     int compareThreshold = 3;
-    CLI::App* compare = app.add_subcommand("compare", "Error metrics of image A against reference B, as JSON (8-bit units)");
+    CLI::App* compare = app.add_subcommand("compare", "Error metrics of image A against reference B (8-bit units): text, or --json");
     compare->add_option("a", compareA, "Test image")->required();
     compare->add_option("b", compareB, "Reference image")->required();
     compare->add_option("--diff", compareDiff, "Write a false-colour difference image");
     compare->add_option("--bad-threshold", compareThreshold, "A pixel is bad when a channel differs by more (default 3)");
+    bool compareJson = false;
+    compare->add_flag("--json", compareJson, "One JSON object instead of text");
 
     app.add_subcommand("devices", "List the Vulkan devices and why any cannot be used");
 
@@ -484,7 +495,7 @@ int main(int argc, char** argv) {
         return runPreviewCommand(po);
     }
     if (app.got_subcommand("devices")) return runDevices();
-    if (compare->parsed()) return runCompare(compareA, compareB, compareDiff, compareThreshold);
+    if (compare->parsed()) return runCompare(compareA, compareB, compareDiff, compareThreshold, compareJson);
     std::cout << app.help();
     return 0;
 }

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include <png.h>
+#include <tinyexr.h>
 #include <unistd.h>
 
 #define STB_IMAGE_IMPLEMENTATION
@@ -75,6 +76,29 @@ private:
     long headerBytes_ = 0;
 };
 
+// OpenEXR through tinyexr: rows are kept, and the file written at the end.
+class ExrWriter : public ImageWriter {
+public:
+    ExrWriter(std::string path, int width, int height) : ImageWriter(std::move(path), width, height) {
+        rgb_.reserve(std::size_t(width) * height * 3);
+    }
+    void writeRows(const float* rgb, int rows) override {
+        rgb_.insert(rgb_.end(), rgb, rgb + std::size_t(width_) * 3 * rows);
+        rowsWritten_ += rows;
+    }
+
+private:
+    void finish() override {
+        const char* error = nullptr;
+        if (SaveEXR(rgb_.data(), width_, height_, 3, 0, temporary_.c_str(), &error) != TINYEXR_SUCCESS) {
+            const std::string message = error ? error : "unknown error";
+            FreeEXRErrorMessage(error);
+            throw ImageIOError("cannot write '" + path_ + "': " + message);
+        }
+    }
+    std::vector<float> rgb_;
+};
+
 // PNG through libpng, row by row; text chunks name the scene and settings.
 class PngWriter : public ImageWriter {
 public:
@@ -137,8 +161,9 @@ ImageFormat formatForPath(const std::string& path) {
     if (ext == ".png") return ImageFormat::Png;
     if (ext == ".ppm") return ImageFormat::Ppm;
     if (ext == ".pfm") return ImageFormat::Pfm;
+    if (ext == ".exr") return ImageFormat::Exr;
     throw ImageIOError("cannot tell the image format of '" + path +
-                       "': use the extension .png, .ppm or .pfm");
+                       "': use the extension .png, .ppm, .pfm or .exr");
 }
 
 void checkWritable(const std::string& path) {
@@ -185,6 +210,7 @@ std::unique_ptr<ImageWriter> ImageWriter::open(const std::string& path, int widt
     case ImageFormat::Png: return std::unique_ptr<ImageWriter>(new PngWriter(path, width, height, text));
     case ImageFormat::Ppm: return std::unique_ptr<ImageWriter>(new PpmWriter(path, width, height));
     case ImageFormat::Pfm: return std::unique_ptr<ImageWriter>(new PfmWriter(path, width, height));
+    case ImageFormat::Exr: return std::unique_ptr<ImageWriter>(new ExrWriter(path, width, height));
     }
     throw ImageIOError("unknown image format");
 }
@@ -215,6 +241,21 @@ void writeImage(const std::string& path, const Image& image, const ImageText& te
 }
 
 Image readImage(const std::string& path) {
+    if (formatForPath(path) == ImageFormat::Exr) {
+        float* rgba = nullptr;
+        int w = 0, h = 0;
+        const char* error = nullptr;
+        if (LoadEXR(&rgba, &w, &h, path.c_str(), &error) != TINYEXR_SUCCESS) {
+            const std::string message = error ? error : "unknown error";
+            FreeEXRErrorMessage(error);
+            throw ImageIOError("cannot read EXR '" + path + "': " + message);
+        }
+        Image image(w, h);
+        for (std::size_t p = 0; p < std::size_t(w) * h; ++p)
+            for (int k = 0; k < 3; ++k) image.rgb[p * 3 + k] = rgba[p * 4 + k];
+        std::free(rgba);
+        return image;
+    }
     std::ifstream in(path, std::ios::binary);
     if (!in) throw ImageIOError("cannot open '" + path + "': " + errorText());
     std::ostringstream buffer;

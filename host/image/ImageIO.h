@@ -1,5 +1,7 @@
-// Image files: PNG (8-bit), PPM P6 (8-bit) and PFM (float, unclamped), chosen
-// by extension. Writing streams rows (an image of any size is written with
+// Image files: PNG (8-bit), PPM P6 (8-bit), PFM and OpenEXR (float,
+// unclamped; EXR through tinyexr, 32-bit float, ZIP), chosen by extension.
+// EXR is the one format written whole at the end: its memory is 12 bytes a
+// pixel. Writing streams rows (an image of any size is written with
 // bounded memory) into a temporary file beside the target, renamed over it
 // only on commit(), so a failed or interrupted write never leaves a partial or
 // clobbered file.
@@ -21,7 +23,7 @@ public:
     using std::runtime_error::runtime_error;
 };
 
-enum class ImageFormat { Png, Ppm, Pfm };
+enum class ImageFormat { Png, Ppm, Pfm, Exr };
 
 // "-" as a path: standard output, as PPM (for pipes). Rows stream out as they
 // finish; a failed render there ends the stream early (and the exit status
