@@ -94,6 +94,10 @@ done
 SNELL_INJECT_FAULT=cosmic-ray "$SNELL" render "$SCENES/basic.scn" -o "$work/x.png" 2>"$work/err"; status=$?
 [ $status -eq 2 ] && grep -q "unknown fault" "$work/err" && ok || bad "bad SNELL_INJECT_FAULT ($status)"
 
+# -v says where the time went, on stderr only.
+"$SNELL" render "$SCENES/basic.scn" --size 16 -o "$work/v.png" -v >"$work/out" 2>"$work/err" &&
+  [ ! -s "$work/out" ] && grep -q "render .* ms (gpu-timestamps\|render .* ms (host" "$work/err" && ok || bad "-v: $(cat "$work/err")"
+
 # -o - streams PPM to standard output (and --stats moves to standard error).
 "$SNELL" render "$SCENES/basic.scn" --size 16 -o - -q --stats >"$work/pipe.ppm" 2>"$work/err"; status=$?
 [ $status -eq 0 ] && [ "$(head -c 2 "$work/pipe.ppm")" = "P6" ] && [ "$(wc -c <"$work/pipe.ppm")" -eq $((13 + 16 * 16 * 3)) ] &&

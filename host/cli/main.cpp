@@ -63,6 +63,7 @@ struct RenderOptions {
     std::string precision = "fp32";
     bool stats = false;
     bool quiet = false;
+    bool verbose = false;
     bool validation = false;
     snell::vk::FaultInjection fault;  // $SNELL_INJECT_FAULT, for tests
 };
@@ -246,6 +247,15 @@ int runRender(const RenderOptions& o) {
         return kExitRuntime;
     }
     writeMs += msSince(commitStart);
+    if (o.verbose) {
+        std::fprintf(stderr,
+                     "snell: %s: %dx%d, %s on %s\n"
+                     "snell: parse %.1f ms, upload %.1f ms, pipeline %.1f ms, render %.1f ms (%s, %d tiles, %d "
+                     "dispatches), readback %.1f ms, write %.1f ms; %.1f ms in all\n",
+                     output.c_str(), request.width, request.height, o.cpu ? "CPU reference" : o.precision.c_str(),
+                     device.c_str(), parseMs, uploadMs, pipelineMs, renderMs, timing.c_str(), tiles, dispatches,
+                     readbackMs, writeMs, msSince(totalStart));
+    }
     if (o.stats) {
         // With the image on standard output, the statistics go to standard error.
         std::ostream& statsOut = output == snell::kStandardOutput ? std::cerr : std::cout;
@@ -404,6 +414,7 @@ int main(int argc, char** argv) {
         ->check(CLI::IsMember({"fp32", "fp64"}));
     render->add_flag("--stats", ro.stats, "Print timings and ray counts as one JSON object on the last line of stdout");
     render->add_flag("-q,--quiet", ro.quiet, "No warnings or progress on stderr");
+    render->add_flag("-v,--verbose", ro.verbose, "Say on stderr which device rendered and where the time went");
     render->add_flag("--validation", ro.validation, "Enable the Khronos validation layer; any message fails the render")
         ->envname("SNELL_VALIDATION");
 

@@ -109,9 +109,10 @@ ComputeRenderer::Specialisation ComputeRenderer::specialise(const RenderRequest&
     values[SNELL_SPEC_COUNT_RAYS] = countRays;
     values[SNELL_SPEC_MAX_MEDIA] = static_cast<std::uint32_t>(
         std::clamp<std::size_t>(layout_.refractiveSpheres, 1, SNELL_MAX_MEDIA_LIMIT));
-    // Depth-first with two children per ray: at most maxDepth + 1 rays wait.
-    values[SNELL_SPEC_RAY_STACK] = static_cast<std::uint32_t>(
-        (hasRefraction || hasReflection) ? request.trace.maxDepth + 1 : 1);
+    // Depth-first with two children per ray: at most maxDepth deferred
+    // reflections and the suspended ray wait. Without refraction a ray has at
+    // most one child, traced at once: only a suspended ray ever waits.
+    values[SNELL_SPEC_RAY_STACK] = static_cast<std::uint32_t>(hasRefraction ? request.trace.maxDepth + 1 : 1);
     values[SNELL_SPEC_AMPLIFYING] = layout_.amplifying;
     values[SNELL_SPEC_LOOP_BUDGET] = context_.isLlvmpipe() ? SNELL_LOOP_BUDGET_LLVMPIPE : 0u;
     return values;
