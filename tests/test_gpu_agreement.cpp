@@ -155,8 +155,7 @@ TEST_P(GpuAgreement, MatchesCpuReference) {
     const snell::ImageMetrics m = snell::compareImages(gpu.image, exact, kBadThreshold);
     // Pixels the reference itself shows to be out of reach are left out of the
     // bad-pixel and speckle counts, and counted.
-    const bool amplifying = std::any_of(scene.materials.begin(), scene.materials.end(),
-                                        [](const snell::Material& mm) { return mm.amplifies(); });
+    const bool amplifying = scene.anyAmplifying();
     std::vector<char> excluded(std::size_t(c.size) * c.size, 0);
     std::uint64_t illConditioned = 0, unconverged = 0;
     for (int y = 0; y < c.size; ++y) {

@@ -17,6 +17,7 @@
 #include <sys/wait.h>
 
 #include "bench/PovExport.h"
+#include "common/Json.h"
 #include "gpu/ComputeRenderer.h"
 #include "kernel_layout.h"
 #include "metrics/ImageMetrics.h"
@@ -49,15 +50,6 @@ Stats stats(std::vector<double> v) {
     const std::size_t n = v.size();
     const double median = n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
     return {median, v.front(), v.back()};
-}
-
-std::string jsonString(const std::string& s) {
-    std::string out = "\"";
-    for (char c : s) {
-        if (c == '"' || c == '\\') out += '\\';
-        out += (static_cast<unsigned char>(c) < 0x20) ? ' ' : c;
-    }
-    return out + "\"";
 }
 
 std::string number(double v) {
@@ -178,9 +170,6 @@ Ceiling measureCeiling(vk::Context& context, int runs, bool quick) {
     return c;
 }
 
-bool amplifies(const Scene& scene) {
-    return std::any_of(scene.materials.begin(), scene.materials.end(), [](const Material& m) { return m.amplifies(); });
-}
 
 std::vector<Setting> settingsFor(const Scene& scene, bool quick) {
     std::vector<Setting> s;
@@ -198,7 +187,7 @@ std::vector<Setting> settingsFor(const Scene& scene, bool quick) {
     for (double w : weights) {
         // Below the default cut-off an amplifying scene's tree (ks + kt > 1)
         // no longer shrinks with depth: 2^64 rays. Its sweep stops there.
-        if (amplifies(scene) && w < kDefaultSettings.minWeight) continue;
+        if (scene.anyAmplifying() && w < kDefaultSettings.minWeight) continue;
         std::ostringstream name;
         name << "min-weight " << w;
         Setting x{name.str()};
@@ -363,7 +352,7 @@ void runBench(const BenchOptions& o, std::ostream& log) {
         // whose trees grow without bound, stop at depth 20 as in the tests).
         RenderRequest exactRequest = base;
         exactRequest.trace = kReferenceSettings;
-        if (amplifies(scene)) exactRequest.trace.maxDepth = 20;
+        if (scene.anyAmplifying()) exactRequest.trace.maxDepth = 20;
         const CpuRenderer cpu(scene);
         const auto cpuStart = Clock::now();
         const Image exact = cpu.render(exactRequest);

@@ -3,6 +3,7 @@
 #include <sstream>
 
 #include "bvh/Bvh.h"
+#include "common/Json.h"
 
 namespace snell {
 
@@ -19,15 +20,6 @@ std::string vec(const dvec3& v) {
     return s.str();
 }
 
-std::string jsonString(const std::string& s) {
-    std::string out = "\"";
-    for (char c : s) {
-        if (c == '"' || c == '\\') out += '\\';
-        out += static_cast<unsigned char>(c) < 0x20 ? ' ' : c;
-    }
-    return out + "\"";
-}
-
 }  // namespace
 
 SceneReport checkScene(const Scene& scene, const std::string& path) {
@@ -38,13 +30,13 @@ SceneReport checkScene(const Scene& scene, const std::string& path) {
     r.lights = scene.lights.size();
     r.materials = scene.materials.size();
     r.warnings = scene.warnings;
+    r.amplifying = scene.anyAmplifying();
     Aabb box;
     const Camera camera = Camera::fromSpec(std::max(1, scene.imageSize), scene.halfWidth);
     for (const Sphere& s : scene.spheres) {
         const Material& m = scene.materials[s.material];
         r.reflective += m.reflects();
         r.refractive += m.refracts();
-        r.amplifying |= m.amplifies();
         const Aabb b = sphereBounds(s);
         box.grow(b);
         const SourceLocation at{path, s.location.line, s.location.column};

@@ -20,6 +20,7 @@
 
 #include "gpu/ComputeRenderer.h"
 #include "bench/Bench.h"
+#include "common/Json.h"
 #include "check/SceneCheck.h"
 #include "preview/Preview.h"
 #include "image/ImageIO.h"
@@ -67,16 +68,6 @@ struct RenderOptions {
     bool validation = false;
     snell::vk::FaultInjection fault;  // $SNELL_INJECT_FAULT, for tests
 };
-
-std::string jsonString(const std::string& s) {
-    std::string out = "\"";
-    for (char c : s) {
-        if (c == '"' || c == '\\') { out += '\\'; out += c; }
-        else if (static_cast<unsigned char>(c) < 0x20) { char b[8]; std::snprintf(b, sizeof b, "\\u%04x", c); out += b; }
-        else out += c;
-    }
-    return out + "\"";
-}
 
 // A progress line on stderr, only when stderr is a terminal.
 class Progress {
@@ -261,8 +252,8 @@ int runRender(const RenderOptions& o) {
         std::ostream& statsOut = output == snell::kStandardOutput ? std::cerr : std::cout;
         std::ostringstream j;
         j.precision(6);
-        j << std::fixed << "{\"scene\": " << jsonString(o.scene) << ", \"output\": " << jsonString(output)
-          << ", \"backend\": \"" << (o.cpu ? "cpu" : "gpu") << "\", \"device\": " << jsonString(device)
+        j << std::fixed << "{\"scene\": " << snell::jsonString(o.scene) << ", \"output\": " << snell::jsonString(output)
+          << ", \"backend\": \"" << (o.cpu ? "cpu" : "gpu") << "\", \"device\": " << snell::jsonString(device)
           << ", \"precision\": \"" << (o.cpu ? "fp64-reference" : o.precision) << "\""
           << ", \"width\": " << request.width << ", \"height\": " << request.height
           << ", \"supersample\": " << request.supersample << ", \"max_depth\": " << request.trace.maxDepth

@@ -150,10 +150,9 @@ GpuScene buildGpuScene(const snell::Scene& scene, const snell::Camera& camera, P
         out.spheres.push_back(g);
         if (wide) out.sphereLows.push_back(low);
     }
-    for (const snell::Material& m : scene.materials) {
+    for (const snell::Material& m : scene.materials)
         out.materials.push_back({toVec4(m.kd, m.phong), toVec4(m.ks, 0.0), toVec4(m.kt, m.eta)});
-        out.amplifying |= m.amplifies();
-    }
+    out.amplifying = scene.anyAmplifying();
     for (const snell::Light& l : scene.lights) {
         Light light{}, low{};
         splitVec4(l.position - eye, 1.0, light.position, low.position);

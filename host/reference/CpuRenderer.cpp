@@ -75,8 +75,7 @@ struct CpuRenderer::PendingRay {
 };
 
 CpuRenderer::CpuRenderer(const Scene& scene) : scene_(scene) {
-    amplifying_ = std::any_of(scene.materials.begin(), scene.materials.end(),
-                              [](const Material& m) { return m.amplifies(); });
+    amplifying_ = scene.anyAmplifying();
     useBvh_ = scene.spheres.size() > kBvhThreshold;
     if (useBvh_) {
         std::vector<Aabb> bounds;

@@ -27,6 +27,10 @@ bool Scene::anyReflection() const {
 
 bool Scene::anyRefraction() const { return refractiveSphereCount() > 0; }
 
+bool Scene::anyAmplifying() const {
+    return std::any_of(materials.begin(), materials.end(), [](const Material& m) { return m.amplifies(); });
+}
+
 Camera Camera::fromSpec(int imageSize, double halfWidth) {
     // SPEC §3: P(x, y) = (-d + x*2d/n, d - y*2d/n, 0), eye E = (0, 0, 1).
     return lookAt(dvec3(0.0, 0.0, 1.0), dvec3(0.0), dvec3(0.0, 1.0, 0.0), halfWidth, imageSize, imageSize);

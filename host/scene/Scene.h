@@ -105,6 +105,8 @@ struct Scene {
     std::size_t refractiveSphereCount() const;
     bool anyReflection() const;
     bool anyRefraction() const;
+    // Some material has ks + kt > 1 in a channel (SPEC §4 "amplifying").
+    bool anyAmplifying() const;
 };
 
 // The camera of SPEC §3, or a general one (the preview's): primary rays leave
