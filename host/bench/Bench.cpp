@@ -359,7 +359,8 @@ void runBench(const BenchOptions& o, std::ostream& log) {
         referenceMs[name] = msSince(cpuStart);
 
         std::map<std::pair<int, int>, std::unique_ptr<ComputeRenderer>> renderers;
-        for (const Setting& setting : settingsFor(scene, o.quick)) {
+        const std::vector<Setting> settings = settingsFor(scene, o.quick);
+        for (const Setting& setting : settings) {
             Result r;
             r.scene = name;
             r.group = file.group;
@@ -395,7 +396,7 @@ void runBench(const BenchOptions& o, std::ostream& log) {
             }
             results.push_back(r);
         }
-        const Result& def = results[results.size() - settingsFor(scene, o.quick).size()];
+        const Result& def = results[results.size() - settings.size()];
         log << name << ": default " << number(def.dispatchMs.median) << " ms, error "
             << number(def.error.meanAbsError) << "/255; reference " << number(referenceMs[name]) << " ms\n";
 
@@ -417,10 +418,8 @@ void runBench(const BenchOptions& o, std::ostream& log) {
             peer.snellDispatchMs = stats(ms).median;
         }
         {
-            RenderRequest cpuRequest = request;
-            cpuRequest.trace.minWeight = 0.0;
             const auto start = Clock::now();
-            cpu.render(cpuRequest);
+            cpu.render(request);
             peer.cpuMs = msSince(start);
         }
         const std::string output = (fs::path(o.outDir) / "peer.png").string();
