@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Write a scaling scene: N spheres in a jittered grid filling a fixed box in
 front of the SPEC camera, a floor and two lights. Used to measure render time
-against sphere count (issue 5): python3 bench/make_scaling_scene.py N > out.scn"""
+against sphere count: python3 bench/make_scaling_scene.py N > out.scn"""
 import math
 import random
 import sys

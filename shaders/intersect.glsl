@@ -36,8 +36,11 @@ real rootsToHit(real b, real a, real c, real discriminant) {
     return near > 0.0 ? near : (far > 0.0 ? far : NO_HIT);
 }
 
-// The unit sphere seen through objectFromWorld (an ellipsoid).
-real intersectEllipsoid(rmat4 objectFromWorld, rvec3 origin, rvec3 dir, uint mode) {
+// The unit sphere seen through objectFromWorld (an ellipsoid). matrixNorm is
+// the largest absolute row sum of its linear part, originLength |origin|: the
+// scales of the rounding in o (prepared once per ellipsoid and per ray).
+real intersectEllipsoid(rmat4 objectFromWorld, real matrixNorm, rvec3 origin, real originLength, rvec3 dir,
+                        uint mode) {
     if (mode == LEAVING) return NO_HIT;
     rvec3 o = (objectFromWorld * rvec4(origin, 1.0)).xyz;
     rvec3 d = rmat3(objectFromWorld) * dir;
@@ -52,19 +55,17 @@ real intersectEllipsoid(rmat4 objectFromWorld, rvec3 origin, rvec3 dir, uint mod
     if (discriminant < 0.0) return NO_HIT;
     real lengthO = length(o);
     // Rounding of o: of the origin through the matrix, and of the product.
-    rmat3 m = rmat3(objectFromWorld);
-    real matrixNorm = max(max(abs(m[0].x) + abs(m[1].x) + abs(m[2].x), abs(m[0].y) + abs(m[1].y) + abs(m[2].y)),
-                           abs(m[0].z) + abs(m[1].z) + abs(m[2].z));
-    if (abs(lengthO - 1.0) <= ROUNDING * (lengthO + 1.0 + matrixNorm * length(origin)))
-        return b < 0.0 ? 0.0 : NO_HIT;
+    if (abs(lengthO - 1.0) <= ROUNDING * (lengthO + 1.0 + matrixNorm * originLength)) return b < 0.0 ? 0.0 : NO_HIT;
     return rootsToHit(b, a, dot(o, o) - 1.0, discriminant);
 }
 
 // A true sphere stored by its anchor (shared_layout.h): the surface point P0
-// (anchorRadius.xyz), the outward normal n0 there and the radius (anchorRadius.w).
-// With g = o − P0, o − centre = g + r n0 and |o − centre|² − r² = |g|² + 2r n0·g.
-real intersectTrueSphere(rvec4 anchorRadius, rvec3 n0, rvec3 origin, rvec3 dir, uint mode) {
+// (anchorRadius.xyz), the outward normal n0 there (normal.xyz) and the radius
+// (anchorRadius.w); normal.w is |P0|, originLength |origin|.
+// With g = o − P0, f = o − centre = g + r n0 and c = |f|² − r² = |g|² + 2r n0·g.
+real intersectTrueSphere(rvec4 anchorRadius, rvec4 normal, rvec3 origin, real originLength, rvec3 dir, uint mode) {
     if (mode == LEAVING) return NO_HIT;
+    rvec3 n0 = normal.xyz;
     rvec3 g = origin - anchorRadius.xyz;
     real r = anchorRadius.w;
     real b = dot(g, dir) + r * dot(n0, dir);
@@ -77,8 +78,10 @@ real intersectTrueSphere(rvec4 anchorRadius, rvec3 n0, rvec3 origin, rvec3 dir, 
     real discriminant = r * r - dot(perpendicular, perpendicular);
     if (discriminant < 0.0) return NO_HIT;
     real c = dot(g, g) + 2.0 * r * dot(n0, g);
-    if (abs(c / (length(f) + r)) <= ROUNDING * (length(origin) + length(anchorRadius.xyz) + length(g)))
-        return b < 0.0 ? 0.0 : NO_HIT;
+    // Within rounding of the surface: |c| / (|f| + r) (the distance to it) is
+    // at most the rounding of g = o − P0, whose operands' scale bounds |g| too:
+    // |o| + |P0| + |g| <= 2 (|o| + |P0|). No division, one square root.
+    if (abs(c) <= 2.0 * ROUNDING * (originLength + normal.w) * (length(f) + r)) return b < 0.0 ? 0.0 : NO_HIT;
     return rootsToHit(b, 1.0, c, discriminant);
 }
 

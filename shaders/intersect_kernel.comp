@@ -28,8 +28,20 @@ void main() {
     vec4 anchorRadius = c.anchorRadius;
     vec3 normal = c.normal.xyz;
 #endif
-    real t = c.kind == SNELL_CASE_ELLIPSOID ? intersectEllipsoid(objectFromWorld, origin, direction, c.mode)
-                                            : intersectTrueSphere(anchorRadius, normal, origin, direction, c.mode);
-    float hi = float(t);
-    results[i] = vec4(hi, float(t - real(hi)), 0.0, 0.0);
+    // What the renderer prepares once per sphere (|P0|, the matrix norm) and per ray (|o|).
+    rmat3 m = rmat3(objectFromWorld);
+    real matrixNorm = max(max(abs(m[0].x) + abs(m[1].x) + abs(m[2].x), abs(m[0].y) + abs(m[1].y) + abs(m[2].y)),
+                          abs(m[0].z) + abs(m[1].z) + abs(m[2].z));
+    real originLength = length(origin);
+    real t = c.kind == SNELL_CASE_ELLIPSOID
+                 ? intersectEllipsoid(objectFromWorld, matrixNorm, origin, originLength, direction, c.mode)
+                 : intersectTrueSphere(anchorRadius, rvec4(normal, length(anchorRadius.xyz)), origin, originLength,
+                                       direction, c.mode);
+#ifdef SNELL_FP64
+    float hi, lo;
+    splitDouble(t, hi, lo);
+    results[i] = vec4(hi, lo, 0.0, 0.0);
+#else
+    results[i] = vec4(t, 0.0, 0.0, 0.0);
+#endif
 }

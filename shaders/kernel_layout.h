@@ -32,7 +32,7 @@ struct IntersectCase {
     uint pad0;
 };
 
-// The device's ceiling (issue 5's micro-kernel, ray_sphere_kernel.comp): one
+// The device's ceiling (the micro-kernel ray_sphere_kernel.comp): one
 // ray per invocation against SNELL_CEILING_SPHERES spheres.
 #define SNELL_CEILING_SPHERES 64
 struct CeilingSphere {

@@ -1,4 +1,4 @@
-// The shader's working precision for geometry (issue 4, --precision): float32
+// The shader's working precision for geometry (--precision): float32
 // by default; compiled with SNELL_FP64 defined, every position, direction and
 // distance is a double (colours stay float). Scene data reaches an fp64 shader
 // as float pairs, hi + lo (shared_layout.h), so it keeps 48 bits of the host's
@@ -15,6 +15,20 @@
 #define rmat4 dmat4
 // Unit roundoff of double: 2^-53.
 const real UNIT_ROUNDOFF = 1.1102230246251565e-16LF;
+
+// v as the float pair hi + lo (48 bits of it). hi is v rounded to 24
+// significant bits by Veltkamp's split (Dekker 1971), exact in double, rather
+// than float(v): Mesa 25's llvmpipe folds double(float(v)) back into v, which
+// would make lo 0 (and Mesa 22's mishandles packDouble2x32).
+void splitDouble(double v, out float hi, out float lo) {
+    precise double c = 536870913.0LF * v;  // 2^29 + 1: keeps 53 − 29 = 24 bits
+    precise double h = c - (c - v);
+    hi = float(h);  // exact
+    lo = float(v - h);
+}
+void splitDouble(dvec3 v, out vec3 hi, out vec3 lo) {
+    for (int k = 0; k < 3; ++k) splitDouble(v[k], hi[k], lo[k]);
+}
 #else
 #define real float
 #define rvec2 vec2

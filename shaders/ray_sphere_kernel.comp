@@ -1,4 +1,4 @@
-// The device's ray–sphere ceiling (issue 5): each invocation casts one ray
+// The device's ray–sphere ceiling: each invocation casts one ray
 // against SNELL_CEILING_SPHERES spheres read from a storage buffer and keeps
 // the nearest hit: nothing but intersection tests, in the centre + radius
 // form (default) or, with SNELL_MATRIX_FORM, the inverse-matrix form the

@@ -1,8 +1,17 @@
 // The one declaration of everything the host and the compute shader share:
-// binding numbers, workgroup size, specialization-constant ids and the std430
-// structs of the scene buffers. Included by C++ (host/gpu/GpuScene.h) and by
-// GLSL (shaders/trace.comp). Members are vec4, mat4 or uint only, so std430 and
+// binding numbers, workgroup size, specialization-constant ids and the structs
+// of the scene's buffers. Included by C++ (host/gpu/GpuScene.h) and by GLSL
+// (shaders/trace.comp). Members are vec4, mat4 or uint only, so std430 and
 // C++ agree without padding rules; host/gpu/GpuScene.h static_asserts sizes.
+//
+// The scene is read-only and reaches the shader as uniform texel buffers, each
+// struct below a run of RGBA32 texels (its vec4 members in order): texel
+// fetches gather a SIMD row's values in one vectorised step on lavapipe, about
+// 3x cheaper than the bounds-checked per-lane loads of a storage buffer
+// (docs/performance.md), and they count elements (2^27 texels on lavapipe), so
+// the documented limit of 4 000 000 spheres fits where 128 MiB of storage
+// buffer does not. Integers that ride in a vec4 are stored as the bits of a
+// uint and read through an RGBA32UI view: no float conversion, exact.
 #ifndef SNELL_SHARED_LAYOUT_H
 #define SNELL_SHARED_LAYOUT_H
 
@@ -13,37 +22,42 @@ namespace snell::gpu {
 using vec4 = glm::vec4;
 using mat4 = glm::mat4;
 using uint = std::uint32_t;
-#define SNELL_CONST constexpr std::uint32_t
-#else
-#define SNELL_CONST const uint
 #endif
 
-// Workgroup: 8x8 pixels, one invocation per pixel.
-#define SNELL_WORKGROUP_SIZE_X 8
-#define SNELL_WORKGROUP_SIZE_Y 8
+// Workgroup: 64 invocations in a row. Invocations are persistent: each one
+// renders a sequence of pixels (shaders/trace.comp), so the shape of the
+// workgroup says nothing about the image.
+#define SNELL_WORKGROUP_SIZE 64
 
-// Descriptor set 0.
-#define SNELL_BINDING_OUTPUT_IMAGE 0
-#define SNELL_BINDING_FRAME 1
-#define SNELL_BINDING_SPHERES 2
-#define SNELL_BINDING_ELLIPSOIDS 3
-#define SNELL_BINDING_MATERIALS 4
-#define SNELL_BINDING_LIGHTS 5
-#define SNELL_BINDING_BVH 6
-#define SNELL_BINDING_COUNTERS 7
-#define SNELL_BINDING_PIXEL_STATES 8
-#define SNELL_BINDING_RAY_STACK 9
-#define SNELL_BINDING_MEDIA_STACK 10
-#define SNELL_BINDING_COUNT_FP32 11
+// Descriptor set 0. Storage buffers: what the shader writes.
+#define SNELL_BINDING_OUTPUT 0         // vec4 pixels[]: the tile, row-major
+#define SNELL_BINDING_COUNTERS 1
+#define SNELL_BINDING_SLOT_STATES 2
+#define SNELL_BINDING_RAY_STACK 3
+#define SNELL_BINDING_MEDIA_STACK 4
+// Uniform buffer: the render's parameters.
+#define SNELL_BINDING_FRAME 5
+// Uniform texel buffers: the scene (RGBA32F unless said).
+#define SNELL_BINDING_SPHERES 6           // Sphere
+#define SNELL_BINDING_SPHERE_MATERIALS 7  // R32UI: the material of each sphere
+#define SNELL_BINDING_ELLIPSOIDS 8        // Ellipsoid
+#define SNELL_BINDING_MATERIALS 9         // Material
+#define SNELL_BINDING_LIGHTS 10           // Light
+#define SNELL_BINDING_BVH 11              // RGBA32UI: BvhNode
+// Uniform buffer: the spheres of a scene small enough to skip the BVH
+// (UnrolledSpheres; for fp64 followed by their low parts), read at constant
+// offsets by the unrolled loops of trace.comp.
+#define SNELL_BINDING_SPHERE_BLOCK 12
+#define SNELL_BINDING_COUNT_FP32 13
 // The fp64 shader (--precision fp64) reads scene values as float pairs hi + lo
 // (hi = float(v), lo = float(v - hi): 48 bits of the host's double): the hi
 // parts are the buffers above, the lo parts twin buffers of the same layout.
-#define SNELL_BINDING_FRAME_LOW 11
-#define SNELL_BINDING_SPHERES_LOW 12
-#define SNELL_BINDING_ELLIPSOIDS_LOW 13
-#define SNELL_BINDING_LIGHTS_LOW 14
-#define SNELL_BINDING_RAY_STACK_LOW 15
-#define SNELL_BINDING_COUNT 16
+#define SNELL_BINDING_FRAME_LOW 13
+#define SNELL_BINDING_SPHERES_LOW 14
+#define SNELL_BINDING_ELLIPSOIDS_LOW 15
+#define SNELL_BINDING_LIGHTS_LOW 16
+#define SNELL_BINDING_RAY_STACK_LOW 17
+#define SNELL_BINDING_COUNT 18
 
 // Specialization constants: compile only what a scene uses.
 #define SNELL_SPEC_USE_BVH 0
@@ -57,51 +71,61 @@ using uint = std::uint32_t;
 #define SNELL_SPEC_AMPLIFYING 8
 #define SNELL_SPEC_LOOP_BUDGET 9
 #define SNELL_SPEC_SHADOWS 10
-#define SNELL_SPEC_COUNT 11
+#define SNELL_SPEC_SPHERE_COUNT 11
+#define SNELL_SPEC_BVH_DEPTH 12
+#define SNELL_SPEC_COUNT 13
 
-// Sphere::ellipsoid when the sphere is a true sphere (centre + radius).
-#define SNELL_NOT_ELLIPSOID 0xffffffffu
 // Slots of the counters buffer: rays by kind, then per-dispatch bookkeeping.
 #define SNELL_COUNTER_PRIMARY 0
 #define SNELL_COUNTER_SHADOW 1
 #define SNELL_COUNTER_REFLECTED 2
 #define SNELL_COUNTER_REFRACTED 3
 #define SNELL_RAY_COUNTER_COUNT 4
-#define SNELL_COUNTER_UNFINISHED 4  // pixels still tracing after this dispatch
+#define SNELL_COUNTER_UNFINISHED 4  // invocations still tracing after this dispatch
 #define SNELL_COUNTER_LOOP_LIMIT 5  // subgroups that may have hit the driver's loop limit
 #define SNELL_COUNTER_COUNT 6
 
-// Mesa's llvmpipe (lavapipe) ends every loop of a shader once one SIMD row has
-// run 65535 loop iterations in total in a dispatch. On such a driver a pixel
-// suspends its ray tree (state below) when its subgroup has spent
+// Mesa's llvmpipe before 24 (lavapipe in Debian 12's Mesa 22.3) ends every
+// loop of a shader once one SIMD row has run 65535 loop iterations in total in
+// a dispatch; newer llvmpipe has no such limit (the renderer probes the
+// driver: host/gpu/ComputeRenderer.cpp). Under the limit an invocation
+// suspends its work (SlotState, the ray stack) when its subgroup has spent
 // SNELL_LOOP_BUDGET iterations, and the next dispatch resumes it.
 #define SNELL_DRIVER_LOOP_LIMIT 65535u
-#define SNELL_LOOP_BUDGET_LLVMPIPE 32768u
+#define SNELL_LOOP_BUDGET_LIMITED 32768u
 
 // Hard upper bound of the shader's per-ray medium stack.
 #define SNELL_MAX_MEDIA_LIMIT 16
 
-// One primitive. Coordinates are relative to the render's origin (a point
-// just in front of the nearest geometry along the view, prepared in double on
-// the host: host/gpu/GpuScene.h). A true sphere is stored by its anchor: the
-// surface point P0 nearest the origin, the outward normal n0 there and the
-// radius, so |f|² − r² = |o − P0|² + 2r n0·(o − P0) has no cancellation near
-// the surface even for a floor of radius 10⁶. For an ellipsoid, anchorRadius
-// is its centre and a bounding radius and `ellipsoid` indexes Ellipsoid.
+// One sphere, as the intersection loop reads it. Coordinates are relative to
+// the render's origin (a point just in front of the nearest geometry along the
+// view, prepared in double on the host: host/gpu/GpuScene.h). A true sphere is
+// stored by its anchor: the surface point P0 nearest the origin, the outward
+// normal n0 there and the radius r > 0, so |f|² − r² = |o − P0|² + 2r n0·(o − P0)
+// has no cancellation near the surface even for a floor of radius 10⁶; normal.w
+// holds |P0|, the scale of the rounding in o − P0. An ellipsoid has
+// anchorRadius = (centre, −1 − e), e its index among the ellipsoids (a float,
+// exact below 2^24), and normal = (0, 0, 0, the largest absolute row sum of its
+// linear part).
 struct Sphere {
-    vec4 anchorRadius;  // xyz: P0, w: radius
-    vec4 normal;        // xyz: n0 (unit), w unused
-    uint material;
-    uint ellipsoid;
-    uint pad0;
-    uint pad1;
+    vec4 anchorRadius;  // xyz: P0 (or the centre), w: r (or −1 − ellipsoid index)
+    vec4 normal;        // xyz: n0 (unit), w: |P0| (or the ellipsoid's matrix norm)
 };
 
-// A sphere whose transform is not a similarity: the unit sphere seen through
-// objectFromWorld (camera-relative world -> object). Its normal matrix is the
-// transpose of objectFromWorld's linear part (SPEC §4.2: M^-T).
+// Scenes of at most this many spheres are intersected without a BVH, by
+// unrolled loops over a uniform buffer (host/gpu/GpuScene.h: kBvhThreshold).
+#define SNELL_MAX_UNROLLED_SPHERES 32
+struct UnrolledSpheres {
+    Sphere spheres[SNELL_MAX_UNROLLED_SPHERES];
+};
+
+// An ellipsoid is the unit sphere seen through objectFromWorld (camera-relative
+// world -> object), an affine map stored as its three rows. Its normal matrix
+// is the transpose of the linear part (SPEC §4.2: M^-T).
 struct Ellipsoid {
-    mat4 objectFromWorld;
+    vec4 row0;
+    vec4 row1;
+    vec4 row2;
 };
 
 // SPEC §2/§4 material: kd.w is the Phong exponent, kt.w the index of refraction.
@@ -116,26 +140,25 @@ struct Light {
     vec4 colour;    // rgb, w unused
 };
 
-// BVH node, stored in depth-first order so the shader walks it without a
-// stack: an inner node's first child is the next node; `skip` is the node
-// after this one's subtree (where to go on a miss, or after a leaf). A leaf
-// (count > 0) holds spheres [first, first + count).
+// A BVH node (read as RGBA32UI: the corners are float bits). Nodes are in
+// depth-first order: an inner node's first child is the next node, its second
+// child the first child's `skip`, the node after the first child's subtree.
+// A leaf's code is first · 4 + count − 1 for spheres [first, first + count),
+// count ≤ SNELL_BVH_MAX_LEAF; an inner node's code is SNELL_BVH_INNER.
 struct BvhNode {
-    vec4 lower;
-    vec4 upper;
-    uint first;
-    uint count;
-    uint skip;
-    uint pad0;
+    vec4 lower;  // xyz: box corner, w: the bits of skip
+    vec4 upper;  // xyz: box corner, w: the bits of the leaf code
 };
+#define SNELL_BVH_MAX_LEAF 4
+#define SNELL_BVH_INNER 0xffffffffu
 
-// A pixel's progress between dispatches (one per pixel of the tile).
-struct PixelState {
-    vec4 sum;       // rgb: sum of the finished samples and of the current one so far
-    uint started;   // samples started
-    uint pending;   // rays waiting on this pixel's stack
-    uint done;
-    uint pad0;
+// An invocation's progress between dispatches (one per invocation).
+struct SlotState {
+    vec4 sum;        // rgb: the current pixel's finished samples and the current one so far
+    uint pixel;      // the pixel of the tile in progress (row-major); ≥ tile size: done
+    uint started;    // samples of it started
+    uint pending;    // rays waiting on this invocation's stack
+    uint finished;   // pixels finished so far in this tile (read by the host for progress)
 };
 
 // A ray waiting to be traced (SPEC §4 ray tree, depth first). Its medium stack
@@ -146,8 +169,8 @@ struct PendingRay {
     vec4 weight;     // rgb: product of the ks/kt factors along its path
     uint depth;
     uint fromSphere; // the sphere whose surface it starts on
-    uint inward;     // 1 if it heads into that sphere
-    uint mediaCount;
+    uint flags;      // bit 0: it heads into that sphere; bits 1..: medium-stack size
+    uint resumeShading;  // 0: not shaded yet; k > 0: suspended while shading, resumes at light k − 1
 };
 
 // Per-render parameters (uniform buffer). The primary ray through the image
@@ -176,16 +199,24 @@ struct FrameParams {
     uint pad2;
 };
 
-// Push constants: the tile of the image this dispatch covers.
+// Push constants: the tile of the image this dispatch covers, and whether it
+// resumes the invocations' suspended work (SlotState) or starts afresh. An
+// invocation steps through the tile's pixels (row-major) by the number of
+// invocations, which is stepY rows and stepX columns (no division per pixel).
 struct TileParams {
     uint originX;
     uint originY;
     uint width;
     uint height;
+    uint resume;
+    uint stepX;
+    uint stepY;
+    uint pad0;
 };
 
 #ifdef __cplusplus
+// Integers carried as float values in a vec4's w are exact below this.
+inline constexpr uint kMaxExactIndex = 1u << 24;
 }  // namespace snell::gpu
 #endif
-#undef SNELL_CONST
 #endif

@@ -1,103 +1,152 @@
-// snell's renderer: one pixel per invocation, SPEC §3–§5 in float32, or in
-// double when compiled with SNELL_FP64 (precision.glsl; --precision fp64).
-// The path of one ray: camera (main) -> trace (explicit stack) -> closestHit /
-// intersectSphere -> shade (local Phong term, shadow rays) -> children pushed
-// on the stack. Its double-precision twin is host/reference/CpuRenderer.cpp;
-// the intersection maths is explained in host/reference/Intersect.h.
+// snell's renderer: SPEC §3–§5 in float32, or in double when compiled with
+// SNELL_FP64 (precision.glsl; --precision fp64).
+// The path of one ray: camera (nextRay) -> closestHit / intersectSphere ->
+// shade (local Phong term, shadow rays) -> children pushed on the explicit
+// stack (spawnChildren). Its double-precision twin is
+// host/reference/CpuRenderer.cpp; the intersection maths is explained in
+// host/reference/Intersect.h.
+//
+// Invocations are persistent: invocation k of K renders pixels k, k + K,
+// k + 2K, ... of the tile, one ray at a time, taking its next pixel as soon as
+// the last one is finished. So a SIMD row stays full while its pixels' ray
+// trees differ in size, and an invocation's ray stack (device memory) is
+// reused from pixel to pixel instead of being one per pixel.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #extension GL_KHR_shader_subgroup_basic : require
 #extension GL_KHR_shader_subgroup_vote : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
+#extension GL_EXT_control_flow_attributes : require
+#extension GL_EXT_samplerless_texture_functions : require
 #include "shared_layout.h"
 #include "intersect.glsl"
 
-layout(local_size_x = SNELL_WORKGROUP_SIZE_X, local_size_y = SNELL_WORKGROUP_SIZE_Y) in;
+layout(local_size_x = SNELL_WORKGROUP_SIZE) in;
 
 // What this scene uses (host/gpu/ComputeRenderer.cpp sets them): code for a
 // feature the scene lacks is dead and removed when the pipeline is compiled.
 layout(constant_id = SNELL_SPEC_USE_BVH) const bool USE_BVH = false;
+// Without a BVH and at most SNELL_MAX_UNROLLED_SPHERES spheres: their number,
+// so the loops over them unroll and read each sphere at a constant offset (on
+// lavapipe ~3x faster than a counted loop); else 0.
+layout(constant_id = SNELL_SPEC_SPHERE_COUNT) const uint SPHERE_COUNT = 1u;
+// With a BVH: the deepest path from the root, which bounds the traversal stack.
+layout(constant_id = SNELL_SPEC_BVH_DEPTH) const uint BVH_DEPTH = 1u;
 layout(constant_id = SNELL_SPEC_HAS_ELLIPSOIDS) const bool HAS_ELLIPSOIDS = true;
 layout(constant_id = SNELL_SPEC_HAS_REFRACTION) const bool HAS_REFRACTION = true;
 layout(constant_id = SNELL_SPEC_HAS_REFLECTION) const bool HAS_REFLECTION = true;
 layout(constant_id = SNELL_SPEC_HAS_LIGHTS) const bool HAS_LIGHTS = true;
 layout(constant_id = SNELL_SPEC_COUNT_RAYS) const bool COUNT_RAYS = false;
 layout(constant_id = SNELL_SPEC_MAX_MEDIA) const int MAX_MEDIA = 1;
-layout(constant_id = SNELL_SPEC_RAY_STACK) const int RAY_STACK = 8;
+layout(constant_id = SNELL_SPEC_RAY_STACK) const uint RAY_STACK = 1u;
 layout(constant_id = SNELL_SPEC_AMPLIFYING) const bool AMPLIFYING = false;
-// Loop iterations a subgroup may spend in one dispatch before its pixels
-// suspend; 0: no limit (drivers without llvmpipe's loop limiter).
+// Loop iterations a subgroup may spend in one dispatch before its invocations
+// suspend; 0: no limit (drivers without llvmpipe's old loop limiter).
 layout(constant_id = SNELL_SPEC_LOOP_BUDGET) const uint LOOP_BUDGET = 0u;
 // Off (a preview inspection switch): no shadow rays, every light is seen.
 layout(constant_id = SNELL_SPEC_SHADOWS) const bool SHADOWS = true;
 
-layout(set = 0, binding = SNELL_BINDING_OUTPUT_IMAGE, rgba32f) uniform writeonly image2D outputImage;
-layout(set = 0, binding = SNELL_BINDING_FRAME, std140) uniform FrameBlock { FrameParams frame; };
-layout(set = 0, binding = SNELL_BINDING_SPHERES, std430) readonly buffer SphereBlock { Sphere spheres[]; };
-layout(set = 0, binding = SNELL_BINDING_ELLIPSOIDS, std430) readonly buffer EllipsoidBlock { Ellipsoid ellipsoids[]; };
-layout(set = 0, binding = SNELL_BINDING_MATERIALS, std430) readonly buffer MaterialBlock { Material materials[]; };
-layout(set = 0, binding = SNELL_BINDING_LIGHTS, std430) readonly buffer LightBlock { Light lights[]; };
-layout(set = 0, binding = SNELL_BINDING_BVH, std430) readonly buffer BvhBlock { BvhNode nodes[]; };
+// What the shader writes: the tile's pixels, row-major (a buffer: on lavapipe
+// an imageStore in a loop costs 13x a buffer store), and its own bookkeeping.
+layout(set = 0, binding = SNELL_BINDING_OUTPUT, std430) writeonly buffer OutputBlock { vec4 outputPixels[]; };
 layout(set = 0, binding = SNELL_BINDING_COUNTERS, std430) buffer CounterBlock { uint counters[]; };
-layout(set = 0, binding = SNELL_BINDING_PIXEL_STATES, std430) buffer PixelStateBlock { PixelState pixelStates[]; };
+layout(set = 0, binding = SNELL_BINDING_SLOT_STATES, std430) buffer SlotStateBlock { SlotState slotStates[]; };
 layout(set = 0, binding = SNELL_BINDING_RAY_STACK, std430) buffer RayStackBlock { PendingRay rayStack[]; };
 layout(set = 0, binding = SNELL_BINDING_MEDIA_STACK, std430) buffer MediaStackBlock { uint mediaStack[]; };
+layout(set = 0, binding = SNELL_BINDING_FRAME, std140) uniform FrameBlock { FrameParams frame; };
 layout(push_constant) uniform TileBlock { TileParams tile; };
+// The scene: texel buffers, each struct of shared_layout.h a run of texels.
+layout(set = 0, binding = SNELL_BINDING_SPHERES) uniform textureBuffer sphereTexels;
+layout(set = 0, binding = SNELL_BINDING_SPHERE_MATERIALS) uniform utextureBuffer sphereMaterialTexels;
+layout(set = 0, binding = SNELL_BINDING_ELLIPSOIDS) uniform textureBuffer ellipsoidTexels;
+layout(set = 0, binding = SNELL_BINDING_MATERIALS) uniform textureBuffer materialTexels;
+layout(set = 0, binding = SNELL_BINDING_LIGHTS) uniform textureBuffer lightTexels;
+layout(set = 0, binding = SNELL_BINDING_BVH) uniform utextureBuffer bvhTexels;
+#ifdef SNELL_FP64
+layout(set = 0, binding = SNELL_BINDING_SPHERE_BLOCK, std140) uniform SphereUniforms {
+    UnrolledSpheres small;
+    UnrolledSpheres smallLow;  // one block: a second uniform buffer crashes Mesa 22's llvmpipe here
+};
+#else
+layout(set = 0, binding = SNELL_BINDING_SPHERE_BLOCK, std140) uniform SphereUniforms { UnrolledSpheres small; };
+#endif
 
 // Scene values as the shader computes with them. In fp64 a value is its float
 // pair hi + lo: the low parts live in twin buffers of the same layout.
 #ifdef SNELL_FP64
 layout(set = 0, binding = SNELL_BINDING_FRAME_LOW, std140) uniform FrameLowBlock { FrameParams frameLow; };
-layout(set = 0, binding = SNELL_BINDING_SPHERES_LOW, std430) readonly buffer SphereLowBlock { Sphere sphereLows[]; };
-layout(set = 0, binding = SNELL_BINDING_ELLIPSOIDS_LOW, std430) readonly buffer EllipsoidLowBlock {
-    Ellipsoid ellipsoidLows[];
-};
-layout(set = 0, binding = SNELL_BINDING_LIGHTS_LOW, std430) readonly buffer LightLowBlock { Light lightLows[]; };
+layout(set = 0, binding = SNELL_BINDING_SPHERES_LOW) uniform textureBuffer sphereTexelsLow;
+layout(set = 0, binding = SNELL_BINDING_ELLIPSOIDS_LOW) uniform textureBuffer ellipsoidTexelsLow;
+layout(set = 0, binding = SNELL_BINDING_LIGHTS_LOW) uniform textureBuffer lightTexelsLow;
 layout(set = 0, binding = SNELL_BINDING_RAY_STACK_LOW, std430) buffer RayStackLowBlock { PendingRay rayStackLow[]; };
 #define WIDE(hi, lo) (dvec4(hi) + dvec4(lo))
-#define WIDE_MATRIX(hi, lo) (dmat4(hi) + dmat4(lo))
+// Texel i of a scene buffer and of its low twin (named ...Low).
+#define FETCH(texels, i) WIDE(texelFetch(texels, int(i)), texelFetch(texels##Low, int(i)))
 #else
 #define WIDE(hi, lo) (hi)
-#define WIDE_MATRIX(hi, lo) (hi)
+#define FETCH(texels, i) texelFetch(texels, int(i))
 #endif
-rvec4 sphereAnchor(uint i) { return WIDE(spheres[i].anchorRadius, sphereLows[i].anchorRadius); }
-rvec3 sphereNormal(uint i) { return WIDE(spheres[i].normal, sphereLows[i].normal).xyz; }
-rmat4 ellipsoidMatrix(uint e) { return WIDE_MATRIX(ellipsoids[e].objectFromWorld, ellipsoidLows[e].objectFromWorld); }
-rvec3 lightPosition(uint j) { return WIDE(lights[j].position, lightLows[j].position).xyz; }
+// A small scene's spheres come from a uniform buffer: the unrolled loops read
+// them at constant offsets, cheaper than texel fetches on lavapipe.
+rvec4 sphereAnchor(uint i) {
+    if (SPHERE_COUNT > 0u) return WIDE(small.spheres[i].anchorRadius, smallLow.spheres[i].anchorRadius);
+    return FETCH(sphereTexels, 2u * i);
+}
+rvec4 sphereNormal(uint i) {
+    if (SPHERE_COUNT > 0u) return WIDE(small.spheres[i].normal, smallLow.spheres[i].normal);
+    return FETCH(sphereTexels, 2u * i + 1u);
+}
+rmat4 ellipsoidMatrix(uint e) {
+    // Rows of the affine map; the matrix's columns are its rows transposed.
+    return transpose(rmat4(FETCH(ellipsoidTexels, 3u * e), FETCH(ellipsoidTexels, 3u * e + 1u),
+                           FETCH(ellipsoidTexels, 3u * e + 2u), rvec4(0.0, 0.0, 0.0, 1.0)));
+}
+rvec3 lightPosition(uint j) { return FETCH(lightTexels, 2u * j).xyz; }
+vec3 lightColour(uint j) { return texelFetch(lightTexels, int(2u * j + 1u)).rgb; }
+uint sphereMaterial(uint i) { return texelFetch(sphereMaterialTexels, int(i)).r; }
+vec4 materialKd(uint m) { return texelFetch(materialTexels, int(3u * m)); }
+vec4 materialKs(uint m) { return texelFetch(materialTexels, int(3u * m + 1u)); }
+vec4 materialKt(uint m) { return texelFetch(materialTexels, int(3u * m + 2u)); }
 
 const uint NONE = 0xffffffffu;
 
 uint countedRays[SNELL_RAY_COUNTER_COUNT];
 
 // Loop iterations this subgroup has run in this dispatch, as llvmpipe's loop
-// limiter counts them: every pass of a loop with some lane active, plus one
-// final pass per loop entry. One lane of the active ones counts each pass, so
-// the subgroup's sum is the count. Compiled out when LOOP_BUDGET is 0.
+// limiter counts them (at least): it counts every pass of a loop with some lane
+// active, and a loop that no lane enters still runs its body once (masked),
+// as old llvmpipe executes both sides of every branch. One lane of the active
+// ones counts each pass, so the subgroup's sum is the count; where a pass may
+// hold a loop that no lane enters, it counts that loop's one pass too. The
+// shader's only loops are the passes over rays, over lights, and of the BVH
+// walk or the sphere loop; the rest are unrolled. Compiled out when
+// LOOP_BUDGET is 0.
 uint loopTicks = 0u;
-void tick() {
-    if (LOOP_BUDGET != 0u && subgroupElect()) loopTicks++;
+void tick(uint passes) {
+    if (LOOP_BUDGET != 0u && subgroupElect()) loopTicks += passes;
 }
 
 // ---------------------------------------------------------------------------
 // Intersection: the maths is in intersect.glsl (shared with the test kernel);
 // here the sphere is fetched and the ray's relation to it decided.
 
-real intersectSphere(uint index, rvec3 origin, rvec3 dir, uint fromSphere, uint start) {
+real intersectSphere(uint index, rvec3 origin, real originLength, rvec3 dir, uint fromSphere, uint start) {
     uint mode = index == fromSphere ? start : ELSEWHERE;
-    if (mode == LEAVING) return NO_HIT;
-    uint ellipsoid = spheres[index].ellipsoid;
-    if (HAS_ELLIPSOIDS && ellipsoid != SNELL_NOT_ELLIPSOID)
-        return intersectEllipsoid(ellipsoidMatrix(ellipsoid), origin, dir, mode);
-    return intersectTrueSphere(sphereAnchor(index), sphereNormal(index), origin, dir, mode);
+    rvec4 anchor = sphereAnchor(index);
+    rvec4 normal = sphereNormal(index);
+    if (HAS_ELLIPSOIDS && anchor.w < 0.0)
+        return intersectEllipsoid(ellipsoidMatrix(uint(-anchor.w) - 1u), normal.w, origin, originLength, dir, mode);
+    return intersectTrueSphere(anchor, normal, origin, originLength, dir, mode);
 }
 
-// Slab test against a node's box (stored rounded outwards), within [0, tMax].
-bool hitsBox(uint node, rvec3 origin, rvec3 inverseDir, real tMax) {
-    rvec3 t0 = (rvec3(nodes[node].lower.xyz) - origin) * inverseDir;
-    rvec3 t1 = (rvec3(nodes[node].upper.xyz) - origin) * inverseDir;
+// Slab test against a node's box (stored rounded outwards) within [0, tMax]:
+// whether the ray meets it, and where it enters it.
+bool hitsBox(rvec4 lower, rvec4 upper, rvec3 origin, rvec3 inverseDir, real tMax, out real enter) {
+    rvec3 t0 = (lower.xyz - origin) * inverseDir;
+    rvec3 t1 = (upper.xyz - origin) * inverseDir;
     rvec3 tNear = min(t0, t1);
     rvec3 tFar = max(t0, t1);
-    real enter = max(max(tNear.x, tNear.y), max(tNear.z, 0.0));
+    enter = max(max(tNear.x, tNear.y), max(tNear.z, 0.0));
     // Ize, "Robust BVH Ray Traversal" (JCGT 2013): widen the exit distance so
     // rounding never culls a box the ray touches.
     real leave = min(min(tFar.x, tFar.y), min(tFar.z, tMax)) * (1.0 + 8.0 * UNIT_ROUNDOFF);
@@ -109,124 +158,117 @@ rvec3 safeInverse(rvec3 d) {
     return 1.0 / mix(d, rvec3(tiny) * sign(d + rvec3(1e-38)), lessThan(abs(d), rvec3(tiny)));
 }
 
+// A BVH node's box corner (texel 2n: lower, 2n + 1: upper); w is not a float.
+rvec4 nodeCorner(uint texel) { return rvec4(uintBitsToFloat(texelFetch(bvhTexels, int(texel)))); }
+
+// The BVH walk shared by the closest hit and the visibility test: nodes in
+// depth-first order (shared_layout.h), an inner node's children n + 1 and the
+// skip link of n + 1. Both children's boxes are tested at the parent and the
+// nearer is entered first, the other waiting on a short per-ray stack (at most
+// BVH_DEPTH entries): the closest hit is found early and then culls the rest.
+// anyHit: stop at the first hit before tMax (SPEC §4.3 visibility).
+uint bvhStack[BVH_DEPTH];
+uint traverseBvh(rvec3 origin, real originLength, rvec3 dir, uint fromSphere, uint start, bool anyHit,
+                 inout real tHit) {
+    rvec3 inverseDir = safeInverse(dir);
+    uint hit = NONE;
+    real enter;
+    if (!hitsBox(nodeCorner(0u), nodeCorner(1u), origin, inverseDir, tHit, enter)) return NONE;
+    uint node = 0u;
+    uint depth = 0u;  // entries on the stack
+    while (true) {
+        tick(1u);
+        uint code = texelFetch(bvhTexels, int(2u * node + 1u)).w;
+        if (code != SNELL_BVH_INNER) {
+            // A leaf: spheres first · 4 + count − 1 = code.
+            uint first = code >> 2;
+            uint last = first + (code & 3u);
+            [[unroll]] for (uint k = 0u; k < SNELL_BVH_MAX_LEAF; ++k) {
+                uint i = first + k;
+                if (i <= last) {
+                    real t = intersectSphere(i, origin, originLength, dir, fromSphere, start);
+                    if (t < tHit) { tHit = t; hit = i; }
+                }
+            }
+            if ((anyHit && hit != NONE) || depth == 0u) break;
+            node = bvhStack[--depth];
+            continue;
+        }
+        uint near = node + 1u;
+        uvec4 nearLower = texelFetch(bvhTexels, int(2u * near));
+        uint far = nearLower.w;
+        real enterNear, enterFar;
+        bool hitsNear = hitsBox(rvec4(uintBitsToFloat(nearLower)), nodeCorner(2u * near + 1u), origin, inverseDir,
+                                tHit, enterNear);
+        bool hitsFar = hitsBox(nodeCorner(2u * far), nodeCorner(2u * far + 1u), origin, inverseDir, tHit, enterFar);
+        if (hitsNear && hitsFar) {
+            if (enterFar < enterNear) { uint n = near; near = far; far = n; }
+            bvhStack[depth++] = far;
+            node = near;
+        } else if (hitsNear || hitsFar) {
+            node = hitsNear ? near : far;
+        } else {
+            if (depth == 0u) break;
+            node = bvhStack[--depth];
+        }
+    }
+    return hit;
+}
+
 // SPEC §4.1: the closest hit with t > 0; returns the sphere index or NONE.
-// The BVH is walked without a stack (nodes in depth-first order with skip
-// links, see shared_layout.h): no per-invocation array, which matters on
-// lavapipe, where dynamically indexed private arrays go to scratch memory.
 uint closestHit(rvec3 origin, rvec3 dir, uint fromSphere, uint start, out real tHit) {
     tHit = NO_HIT;
+    real originLength = length(origin);
+    if (USE_BVH) return traverseBvh(origin, originLength, dir, fromSphere, start, false, tHit);
     uint hit = NONE;
-    if (!USE_BVH) {
-        tick();
-        for (uint i = 0u; i < frame.sphereCount; ++i) {
-            tick();
-            real t = intersectSphere(i, origin, dir, fromSphere, start);
+    if (SPHERE_COUNT > 0u) {
+        [[unroll]] for (uint i = 0u; i < SPHERE_COUNT; ++i) {
+            real t = intersectSphere(i, origin, originLength, dir, fromSphere, start);
             if (t < tHit) { tHit = t; hit = i; }
         }
         return hit;
     }
-    rvec3 inverseDir = safeInverse(dir);
-    uint node = 0u;
-    tick();
-    while (node < frame.bvhNodeCount) {
-        tick();
-        if (!hitsBox(node, origin, inverseDir, tHit)) {
-            node = nodes[node].skip;
-            continue;
-        }
-        uint count = nodes[node].count;
-        if (count == 0u) {
-            node++;
-            continue;
-        }
-        uint first = nodes[node].first;
-        tick();
-        for (uint i = first; i < first + count; ++i) {
-            tick();
-            real t = intersectSphere(i, origin, dir, fromSphere, start);
-            if (t < tHit) { tHit = t; hit = i; }
-        }
-        node = nodes[node].skip;
+    for (uint i = 0u; i < frame.sphereCount; ++i) {  // no BVH, by request (the benchmark)
+        tick(1u);
+        real t = intersectSphere(i, origin, originLength, dir, fromSphere, start);
+        if (t < tHit) { tHit = t; hit = i; }
     }
     return hit;
 }
 
 // SPEC §4.3 visibility: does any surface cross the open segment (0, distance)?
+// Stops at the first occluder.
 bool occluded(rvec3 origin, rvec3 dir, real distance, uint fromSphere, uint start) {
+    real originLength = length(origin);
+    if (USE_BVH) return traverseBvh(origin, originLength, dir, fromSphere, start, true, distance) != NONE;
     bool blocked = false;
-    if (!USE_BVH) {
-        tick();
-        for (uint i = 0u; i < frame.sphereCount && !blocked; ++i) {
-            tick();
-            blocked = intersectSphere(i, origin, dir, fromSphere, start) < distance;
+    if (SPHERE_COUNT > 0u) {
+        [[unroll]] for (uint i = 0u; i < SPHERE_COUNT; ++i) {
+            if (!blocked) blocked = intersectSphere(i, origin, originLength, dir, fromSphere, start) < distance;
         }
         return blocked;
     }
-    rvec3 inverseDir = safeInverse(dir);
-    uint node = 0u;
-    tick();
-    while (node < frame.bvhNodeCount && !blocked) {
-        tick();
-        if (!hitsBox(node, origin, inverseDir, distance)) {
-            node = nodes[node].skip;
-            continue;
-        }
-        uint count = nodes[node].count;
-        if (count == 0u) {
-            node++;
-            continue;
-        }
-        uint first = nodes[node].first;
-        tick();
-        for (uint i = first; i < first + count && !blocked; ++i) {
-            tick();
-            blocked = intersectSphere(i, origin, dir, fromSphere, start) < distance;
-        }
-        node = nodes[node].skip;
+    for (uint i = 0u; i < frame.sphereCount && !blocked; ++i) {
+        tick(1u);
+        blocked = intersectSphere(i, origin, originLength, dir, fromSphere, start) < distance;
     }
     return blocked;
 }
 
 // ---------------------------------------------------------------------------
-// The ray tree (SPEC §4), depth first on an explicit stack kept per pixel in
-// rayStack/mediaStack, so a pixel can suspend between dispatches. Each pending
-// ray carries its weight, depth, the sphere it starts on, whether it heads into
-// that sphere, and its medium stack (innermost last).
+// The ray tree (SPEC §4), depth first on an explicit stack kept per invocation
+// in rayStack/mediaStack, so an invocation can suspend between dispatches.
+// Each pending ray carries its weight, depth, the sphere it starts on, whether
+// it heads into that sphere, and its medium stack (innermost last).
 
 bool worthTracing(vec3 w) {
     float m = max(w.x, max(w.y, w.z));
     return m > 0.0 && m >= frame.ambient.w;
 }
 
-// Local Phong term with binary shadows (SPEC §4.3) at x with shading normal n.
-vec3 shade(Material m, rvec3 x, rvec3 n, rvec3 v, uint hitSphere, bool fromOutside) {
-    vec3 local = frame.ambient.rgb * m.kd.rgb;
-    if (HAS_LIGHTS) {
-        // A shadow ray towards N's side enters the hit sphere only when N = −No.
-        uint start = fromOutside ? LEAVING : ENTERING;
-        tick();
-        for (uint j = 0u; j < frame.lightCount; ++j) {
-            tick();
-            rvec3 l = lightPosition(j) - x;
-            real distance = length(l);
-            l /= distance;
-            float nl = float(dot(n, l));
-            if (nl > 0.0) {
-                if (COUNT_RAYS && SHADOWS) countedRays[SNELL_COUNTER_SHADOW]++;
-                if (!SHADOWS || !occluded(x, l, distance, hitSphere, start)) {
-                    float rv = float(dot(2.0 * dot(n, l) * n - l, v));
-                    float specular = rv > 0.0 ? pow(rv, m.kd.w) : 0.0;
-                    local += lights[j].colour.rgb * (m.kd.rgb * nl + m.ks.rgb * specular);
-                }
-            }
-        }
-    }
-    return local;
-}
-
 // The ray being traced lives in registers; only a deferred child (the
-// reflected one, when a ray also refracts) goes to the pixel's stack in
-// device memory, and so does the current ray when the pixel suspends.
+// reflected one, when a ray also refracts) goes to the stack in device memory,
+// and so does the current ray when the invocation suspends.
 struct Ray {
     rvec3 origin;
     rvec3 dir;
@@ -235,114 +277,140 @@ struct Ray {
     uint fromSphere;  // the sphere whose surface it starts on
     bool inward;      // it heads into that sphere
     uint mediaCount;  // its medium stack is `media`, innermost last
+    uint resumeShading;  // 0: not shaded yet; k > 0: shading resumes at light k − 1
 };
+// The medium stack of the ray in hand, innermost last. Every access is in a
+// loop unrolled over MAX_MEDIA, so each entry has a constant index and the
+// array lives in registers rather than in scratch memory.
 uint media[MAX_MEDIA];
+uint mediumAt(uint k) {
+    uint sphere = NONE;
+    [[unroll]] for (int i = 0; i < MAX_MEDIA; ++i)
+        if (uint(i) == k) sphere = media[i];
+    return sphere;
+}
 
-float etaOfSphere(uint sphere) { return materials[spheres[sphere].material].kt.w; }
+// Where a ray met its closest surface, and what shading needs there.
+struct Hit {
+    uint sphere;
+    uint material;
+    rvec3 point;
+    rvec3 normal;     // the shading normal N (against the ray)
+    bool fromOutside; // the ray arrived from outside the sphere
+};
 
-void pushRay(uint pixel, inout PixelState state, Ray r) {
-    uint slot = pixel * uint(RAY_STACK) + state.pending;
-    vec4 origin = vec4(r.origin, 0.0);
-    vec4 dir = vec4(r.dir, 0.0);
-    rayStack[slot] = PendingRay(origin, dir, vec4(r.weight, 0.0), r.depth, r.fromSphere, r.inward ? 1u : 0u,
-                                r.mediaCount);
+float etaOfSphere(uint sphere) { return materialKt(sphereMaterial(sphere)).w; }
+
+void pushRay(uint slot, inout uint pending, Ray r) {
+    uint entry = slot * RAY_STACK + pending;
 #ifdef SNELL_FP64
-    rayStackLow[slot].origin = vec4(r.origin - dvec3(origin.xyz), 0.0);
-    rayStackLow[slot].direction = vec4(r.dir - dvec3(dir.xyz), 0.0);
+    vec3 origin, originLow, dir, dirLow;
+    splitDouble(r.origin, origin, originLow);
+    splitDouble(r.dir, dir, dirLow);
+    rayStackLow[entry].origin = vec4(originLow, 0.0);
+    rayStackLow[entry].direction = vec4(dirLow, 0.0);
+#else
+    vec3 origin = r.origin, dir = r.dir;
 #endif
-    tick();
-    for (uint k = 0u; k < r.mediaCount; ++k) {
-        tick();
-        mediaStack[slot * uint(MAX_MEDIA) + k] = media[k];
-    }
-    state.pending++;
+    rayStack[entry] = PendingRay(vec4(origin, 0.0), vec4(dir, 0.0), vec4(r.weight, 0.0), r.depth, r.fromSphere,
+                                 (r.inward ? 1u : 0u) | (r.mediaCount << 1), r.resumeShading);
+    [[unroll]] for (int k = 0; k < MAX_MEDIA; ++k)
+        if (uint(k) < r.mediaCount) mediaStack[entry * uint(MAX_MEDIA) + uint(k)] = media[k];
+    pending++;
 }
 
-Ray popRay(uint pixel, inout PixelState state) {
-    state.pending--;
-    uint slot = pixel * uint(RAY_STACK) + state.pending;
-    PendingRay p = rayStack[slot];
-    tick();
-    for (uint k = 0u; k < p.mediaCount; ++k) {
-        tick();
-        media[k] = mediaStack[slot * uint(MAX_MEDIA) + k];
-    }
-    return Ray(WIDE(p.origin, rayStackLow[slot].origin).xyz, WIDE(p.direction, rayStackLow[slot].direction).xyz,
-               p.weight.rgb, p.depth, p.fromSphere, p.inward != 0u, p.mediaCount);
+Ray popRay(uint slot, inout uint pending) {
+    pending--;
+    uint entry = slot * RAY_STACK + pending;
+    PendingRay p = rayStack[entry];
+    uint mediaCount = p.flags >> 1;
+    [[unroll]] for (int k = 0; k < MAX_MEDIA; ++k)
+        if (uint(k) < mediaCount) media[k] = mediaStack[entry * uint(MAX_MEDIA) + uint(k)];
+    return Ray(WIDE(p.origin, rayStackLow[entry].origin).xyz, WIDE(p.direction, rayStackLow[entry].direction).xyz,
+               p.weight.rgb, p.depth, p.fromSphere, (p.flags & 1u) != 0u, mediaCount, p.resumeShading);
 }
 
-// Trace ray r: closest hit, local term, children. On return r is the child
-// to trace next (hasRay), the other child having been pushed on the stack;
-// refraction is traced first, as in the CPU reference.
-void traceRay(uint pixel, inout PixelState state, inout Ray r, out bool hasRay, float saturation) {
-    hasRay = false;
-    vec3 weight = r.weight;
-    if (AMPLIFYING) weight = mix(weight, vec3(0.0), greaterThanEqual(state.sum.rgb, vec3(saturation)));
-    if (!worthTracing(weight)) return;
-    rvec3 o = r.origin;
-    rvec3 d = r.dir;
-
-    // 1. Closest hit.
+// 1–2. The closest hit of ray r: on a miss the background is added to the
+// pixel and false returned; on a hit, where and how it was hit. A ray that
+// resumes shading (resumeShading > 0) finds the same hit again.
+bool findHit(Ray r, vec3 weight, inout vec3 sum, out Hit h) {
     real t;
-    uint hitSphere = closestHit(o, d, r.fromSphere, r.inward ? ENTERING : LEAVING, t);
-    if (hitSphere == NONE) {
-        state.sum.rgb += weight * frame.background.rgb;
-        return;
+    h.sphere = closestHit(r.origin, r.dir, r.fromSphere, r.inward ? ENTERING : LEAVING, t);
+    if (h.sphere == NONE) {
+        sum += weight * frame.background.rgb;
+        return false;
     }
-    uint ellipsoid = spheres[hitSphere].ellipsoid;
-    Material m = materials[spheres[hitSphere].material];
-
-    // 2. Hit point o + t d, not re-projected onto the surface: re-projecting
+    h.material = sphereMaterial(h.sphere);
+    // The hit point o + t d, not re-projected onto the surface: re-projecting
     // (centre + r n̂, or normalising the object-space point) rounds at the
     // scale of the centre or of the largest semi-axis, which for a big floor
     // sphere near the camera is 100× the error of o + t d. Self-intersection
     // needs no point exactly on the surface (see intersectSphere).
-    rvec3 x = o + t * d;
+    rvec3 o = r.origin;
+    rvec3 d = r.dir;
+    h.point = o + t * d;
+    rvec4 anchor = sphereAnchor(h.sphere);
     rvec3 outward;
-    if (HAS_ELLIPSOIDS && ellipsoid != SNELL_NOT_ELLIPSOID) {
-        rmat4 objectFromWorld = ellipsoidMatrix(ellipsoid);
+    if (HAS_ELLIPSOIDS && anchor.w < 0.0) {
+        rmat4 objectFromWorld = ellipsoidMatrix(uint(-anchor.w) - 1u);
         rvec3 p = (objectFromWorld * rvec4(o, 1.0)).xyz + t * (rmat3(objectFromWorld) * d);
         outward = normalize(transpose(rmat3(objectFromWorld)) * p);
     } else {
-        rvec4 anchor = sphereAnchor(hitSphere);
-        outward = normalize(o - anchor.xyz + t * d + anchor.w * sphereNormal(hitSphere));
+        outward = normalize(o - anchor.xyz + t * d + anchor.w * sphereNormal(h.sphere).xyz);
     }
-    bool fromOutside = dot(d, outward) < 0.0;
-    rvec3 n = fromOutside ? outward : -outward;
+    h.fromOutside = dot(d, outward) < 0.0;
+    h.normal = h.fromOutside ? outward : -outward;
+    return true;
+}
 
-    // 3. Local term.
-    state.sum.rgb += weight * shade(m, x, n, -d, hitSphere, fromOutside);
+// 3. Light j's part of the local Phong term with binary shadows (SPEC §4.3).
+vec3 shadeLight(uint j, Hit h, rvec3 v) {
+    rvec3 l = lightPosition(j) - h.point;
+    real distance = length(l);
+    l *= 1.0 / distance;  // one division, not three
+    float nl = float(dot(h.normal, l));
+    if (!(nl > 0.0)) return vec3(0.0);
+    if (COUNT_RAYS && SHADOWS) countedRays[SNELL_COUNTER_SHADOW]++;
+    // A shadow ray towards N's side enters the hit sphere only when N = −No.
+    if (SHADOWS && occluded(h.point, l, distance, h.sphere, h.fromOutside ? LEAVING : ENTERING)) return vec3(0.0);
+    float rv = float(dot(2.0 * dot(h.normal, l) * h.normal - l, v));
+    vec4 kd = materialKd(h.material);
+    float specular = rv > 0.0 ? pow(rv, kd.w) : 0.0;
+    return lightColour(j) * (kd.rgb * nl + materialKs(h.material).rgb * specular);
+}
+
+// 4–5. The children of ray r at hit h: reflection (keeps the medium stack) and
+// refraction (SPEC §4.5). On return r is the child to trace next (hasRay), the
+// other child having been pushed on the stack; refraction is traced first, as
+// in the CPU reference.
+void spawnChildren(uint slot, inout uint pending, inout Ray r, vec3 weight, Hit h, out bool hasRay) {
+    hasRay = false;
     if (r.depth >= frame.maxDepth) return;
-
-    // 4. Reflection (keeps the medium stack) and 5. refraction.
-    vec3 reflectedWeight = HAS_REFLECTION ? weight * m.ks.rgb : vec3(0.0);
+    rvec3 d = r.dir;
+    rvec3 n = h.normal;
+    vec3 reflectedWeight = HAS_REFLECTION ? weight * materialKs(h.material).rgb : vec3(0.0);
     bool refracts = false;
     rvec3 refracted = rvec3(0.0);
     vec3 transmittedWeight = vec3(0.0);
     uint removeAt = r.mediaCount;  // leaving: where this sphere is in the stack
-    if (HAS_REFRACTION && max(m.kt.r, max(m.kt.g, m.kt.b)) > 0.0) {
-        transmittedWeight = weight * m.kt.rgb;
+    vec4 kt = HAS_REFRACTION ? materialKt(h.material) : vec4(0.0);
+    if (HAS_REFRACTION && max(kt.r, max(kt.g, kt.b)) > 0.0) {
+        transmittedWeight = weight * kt.rgb;
         real etaI, etaT;
-        if (fromOutside) {
+        if (h.fromOutside) {
             // Entering: from the current medium into this sphere.
-            etaI = r.mediaCount == 0u ? frame.background.w : etaOfSphere(media[r.mediaCount - 1u]);
-            etaT = m.kt.w;
+            etaI = r.mediaCount == 0u ? frame.background.w : etaOfSphere(mediumAt(r.mediaCount - 1u));
+            etaT = kt.w;
         } else {
             // Leaving: into the medium that remains once this sphere is removed
             // from the stack (its innermost occurrence; none: nothing removed).
-            etaI = m.kt.w;
-            tick();
-            for (uint k = 0u; k < r.mediaCount; ++k) {
-                tick();
-                if (media[k] == hitSphere) removeAt = k;
-            }
-            uint innermost = r.mediaCount;  // the innermost one that stays
-            tick();
-            for (uint k = 0u; k < r.mediaCount; ++k) {
-                tick();
-                if (k != removeAt) innermost = k;
-            }
-            etaT = innermost == r.mediaCount ? frame.background.w : etaOfSphere(media[innermost]);
+            etaI = kt.w;
+            [[unroll]] for (int k = 0; k < MAX_MEDIA; ++k)
+                if (uint(k) < r.mediaCount && media[k] == h.sphere) removeAt = uint(k);
+            uint innermost = NONE;  // the innermost one that stays
+            [[unroll]] for (int k = 0; k < MAX_MEDIA; ++k)
+                if (uint(k) < r.mediaCount && uint(k) != removeAt) innermost = media[k];
+            etaT = innermost == NONE ? frame.background.w : etaOfSphere(innermost);
         }
         // Snell's law, SPEC §4.5.
         real eta = etaI / etaT;
@@ -358,8 +426,8 @@ void traceRay(uint pixel, inout PixelState state, inout Ray r, out bool hasRay, 
         }
     }
     bool reflects = (HAS_REFLECTION || HAS_REFRACTION) && worthTracing(reflectedWeight);
-    Ray reflectedRay = Ray(x, d - 2.0 * dot(d, n) * n, reflectedWeight, r.depth + 1u, hitSphere, !fromOutside,
-                           r.mediaCount);
+    Ray reflectedRay = Ray(h.point, d - 2.0 * dot(d, n) * n, reflectedWeight, r.depth + 1u, h.sphere, !h.fromOutside,
+                           r.mediaCount, 0u);
     if (reflects) {
         if (COUNT_RAYS) countedRays[SNELL_COUNTER_REFLECTED]++;
         if (!refracts) {
@@ -367,104 +435,156 @@ void traceRay(uint pixel, inout PixelState state, inout Ray r, out bool hasRay, 
             hasRay = true;
             return;
         }
-        pushRay(pixel, state, reflectedRay);  // with the parent's media, still current
+        pushRay(slot, pending, reflectedRay);  // with the parent's media, still current
     }
     if (refracts) {
         if (COUNT_RAYS) countedRays[SNELL_COUNTER_REFRACTED]++;
         uint count = r.mediaCount;
-        if (fromOutside) {
+        if (h.fromOutside) {
             if (count == uint(MAX_MEDIA)) {  // deeper than the scene can nest: forget the outermost
-                tick();
-                for (uint k = 0u; k + 1u < count; ++k) {
-                    tick();
-                    media[k] = media[k + 1u];
-                }
+                [[unroll]] for (int k = 0; k + 1 < MAX_MEDIA; ++k) media[k] = media[k + 1];
                 count--;
             }
-            media[count] = hitSphere;
+            [[unroll]] for (int k = 0; k < MAX_MEDIA; ++k)
+                if (uint(k) == count) media[k] = h.sphere;
             count++;
         } else if (removeAt < count) {
-            tick();
-            for (uint k = removeAt; k + 1u < count; ++k) {
-                tick();
-                media[k] = media[k + 1u];
-            }
+            [[unroll]] for (int k = 0; k + 1 < MAX_MEDIA; ++k)
+                if (uint(k) >= removeAt && uint(k) + 1u < count) media[k] = media[k + 1];
             count--;
         }
-        r = Ray(x, refracted, transmittedWeight, r.depth + 1u, hitSphere, fromOutside, count);
+        r = Ray(h.point, refracted, transmittedWeight, r.depth + 1u, h.sphere, h.fromOutside, count, 0u);
         hasRay = true;
     }
 }
 
-void main() {
-    uvec2 local = gl_GlobalInvocationID.xy;
-    bool inTile = local.x < tile.width && local.y < tile.height;
-    uint pixel = local.y * tile.width + local.x;
-    for (int k = 0; k < SNELL_RAY_COUNTER_COUNT; ++k) countedRays[k] = 0u;
+// SPEC §3: sub-pixel sample k of pixel p: the ray through
+// (i + (a+½)/s, j + (b+½)/s), from the eye, starting at distance D along it.
+Ray cameraRay(uvec2 p, uint k) {
+    // k = b·s + a with k < s² ≤ 64²: b is exact from float division.
+    float s = float(frame.supersample);
+    float b = floor((float(k) + 0.5) / s);
+    rvec2 ab = rvec2(float(k) - b * s, b);
+    rvec2 q = rvec2(p) + (ab + 0.5) / real(s);
+    rvec3 corner = WIDE(frame.cornerDir, frameLow.cornerDir).xyz;
+    rvec3 right = WIDE(frame.pixelRight, frameLow.pixelRight).xyz;
+    rvec3 down = WIDE(frame.pixelDown, frameLow.pixelDown).xyz;
+    rvec3 dir = normalize(corner + q.x * right + q.y * down);
+    rvec4 primaryStart = WIDE(frame.primaryStart, frameLow.primaryStart);
+    return Ray(primaryStart.xyz + primaryStart.w * dir, dir, vec3(1.0), 0u, NONE, false, 0u, 0u);
+}
 
-    PixelState state;
-    bool done = true;
-    if (inTile) {
-        state = pixelStates[pixel];
-        done = state.done != 0u;
-    }
-    // SPEC §3: s×s rays through (i + (a+½)/s, j + (b+½)/s); mean, then clamp on output.
-    uint s = frame.supersample;
+void main() {
+    uint slot = gl_GlobalInvocationID.x;
+    uint slots = gl_NumWorkGroups.x * uint(SNELL_WORKGROUP_SIZE);
+    uint tilePixels = tile.width * tile.height;
+    [[unroll]] for (int k = 0; k < SNELL_RAY_COUNTER_COUNT; ++k) countedRays[k] = 0u;
+
+    // This invocation's progress: its current pixel, that pixel's sum, and the
+    // rays on its stack. Fresh, or resumed from the last dispatch.
+    SlotState state = SlotState(vec4(0.0), slot, 0u, 0u, 0u);
+    if (tile.resume != 0u) state = slotStates[slot];
+    bool done = state.pixel >= tilePixels;
+    uvec2 pixel = uvec2(state.pixel % tile.width, state.pixel / tile.width);  // within the tile
     uint samples = frame.sampleCount;
+    // SPEC §4 amplifying materials: a channel whose pixel sum has reached 1
+    // (times the samples, as the sum is of samples) is final in 8 bits.
     float saturation = AMPLIFYING ? float(samples) : 3.0e38;
-    uvec2 imagePixel = local + uvec2(tile.originX, tile.originY);
 
     Ray ray;
     bool hasRay = false;
-    // Every lane stays in this loop until the subgroup leaves it together, so
-    // the subgroup operations below see all lanes.
+    bool suspended = false;
+    // With a loop budget every lane stays in this loop until the subgroup
+    // leaves it together, so the subgroup operations below see all lanes.
     while (true) {
         if (LOOP_BUDGET != 0u) {
-            if (subgroupAll(done) || subgroupAdd(loopTicks) >= LOOP_BUDGET) break;
+            if (subgroupAll(done)) break;
+            if (subgroupAdd(loopTicks) >= LOOP_BUDGET) {
+                suspended = true;
+                break;
+            }
         } else if (done) {
             break;
         }
-        tick();
-        if (!done) {
-            if (!hasRay && state.pending > 0u) {
-                ray = popRay(pixel, state);
+        tick(2u);  // this pass, and the closest-hit loop should no lane enter it
+        if (!done && !hasRay) {
+            if (state.pending > 0u) {
+                ray = popRay(slot, state.pending);
                 hasRay = true;
+            } else if (state.started == samples) {
+                // The pixel is finished: SPEC §3 mean, clamped on output. Next pixel.
+                outputPixels[state.pixel] = vec4(state.sum.rgb / float(samples), 1.0);
+                state.finished++;
+                slotStates[slot].finished = state.finished;
+                state.pixel += slots;
+                pixel += uvec2(tile.stepX, tile.stepY);
+                if (pixel.x >= tile.width) pixel += uvec2(-tile.width, 1u);
+                state.started = 0u;
+                state.sum = vec4(0.0);
+                done = state.pixel >= tilePixels;
             }
-            if (!hasRay) {
-                if (state.started == samples) {
-                    done = true;
-                } else {
-                    // Camera: the next primary ray of this pixel.
-                    uint k = frame.firstSample + state.started;
-                    uvec2 ab = uvec2(k % s, k / s);
-                    rvec2 p = rvec2(imagePixel) + (rvec2(ab) + 0.5) / real(s);
-                    rvec3 corner = WIDE(frame.cornerDir, frameLow.cornerDir).xyz;
-                    rvec3 right = WIDE(frame.pixelRight, frameLow.pixelRight).xyz;
-                    rvec3 down = WIDE(frame.pixelDown, frameLow.pixelDown).xyz;
-                    rvec3 dir = normalize(corner + p.x * right + p.y * down);
-                    // It starts at distance D along its way, before any geometry.
-                    rvec4 primaryStart = WIDE(frame.primaryStart, frameLow.primaryStart);
-                    rvec3 start = primaryStart.xyz + primaryStart.w * dir;
-                    ray = Ray(start, dir, vec3(1.0), 0u, NONE, false, 0u);
-                    hasRay = true;
-                    state.started++;
-                    if (COUNT_RAYS) countedRays[SNELL_COUNTER_PRIMARY]++;
-                }
+            if (!done && !hasRay) {
+                ray = cameraRay(pixel + uvec2(tile.originX, tile.originY), frame.firstSample + state.started);
+                state.started++;
+                hasRay = true;
+                if (COUNT_RAYS) countedRays[SNELL_COUNTER_PRIMARY]++;
             }
-            if (hasRay) traceRay(pixel, state, ray, hasRay, saturation);
         }
+
+        // Trace the ray in hand: closest hit, local term, children.
+        vec3 weight = vec3(0.0);
+        Hit h;
+        bool shading = false;
+        if (hasRay) {
+            weight = ray.weight;
+            if (AMPLIFYING) weight = mix(weight, vec3(0.0), greaterThanEqual(state.sum.rgb, vec3(saturation)));
+            if (worthTracing(weight)) {
+                vec3 sum = state.sum.rgb;
+                shading = findHit(ray, weight, sum, h);
+                // The ambient part once, not again when shading resumes.
+                if (shading && ray.resumeShading == 0u) sum += weight * frame.ambient.rgb * materialKd(h.material).rgb;
+                state.sum.rgb = sum;
+            }
+            hasRay = shading;
+        }
+        // 3. Lights, each added to the pixel as it is shaded, in light order
+        // (the same sums whether or not shading is suspended part-way).
+        rvec3 v = -ray.dir;
+        if (HAS_LIGHTS && LOOP_BUDGET == 0u && shading) {
+            for (uint j = 0u; j < frame.lightCount; ++j) state.sum.rgb += weight * shadeLight(j, h, v);
+        }
+        if (HAS_LIGHTS && LOOP_BUDGET != 0u) {
+            // Every lane runs this loop (it is not inside `if (shading)`), so the
+            // subgroup can check its budget between lights: one ray's shading
+            // may take any number of lights, over several dispatches.
+            // Rays that resume start where they stopped: the loop starts at the
+            // first light some lane still needs, so every dispatch moves on.
+            uint firstLight = subgroupMin(shading ? max(ray.resumeShading, 1u) - 1u : frame.lightCount);
+            for (uint j = firstLight; j < frame.lightCount; ++j) {
+                // At least one light a dispatch, whatever the hit cost: progress.
+                if (j > firstLight && subgroupAdd(loopTicks) >= LOOP_BUDGET) {
+                    suspended = true;
+                    if (shading) ray.resumeShading = max(ray.resumeShading, j + 1u);  // the ray waits, to resume here
+                    break;
+                }
+                tick(2u);  // this light, and the occlusion loop should no lane enter it
+                if (shading && j + 1u >= ray.resumeShading) state.sum.rgb += weight * shadeLight(j, h, v);
+            }
+            if (suspended) break;
+        }
+        if (shading) spawnChildren(slot, state.pending, ray, weight, h, hasRay);
     }
 
-    if (inTile) {
-        // Suspending: the ray in hand waits on the stack for the next dispatch.
-        if (hasRay) pushRay(pixel, state, ray);
-        state.done = done ? 1u : 0u;
-        pixelStates[pixel] = state;
-        if (done) imageStore(outputImage, ivec2(local), vec4(state.sum.rgb / float(samples), 1.0));
-        else atomicAdd(counters[SNELL_COUNTER_UNFINISHED], 1u);
+    if (suspended) {
+        // The ray in hand waits on the stack for the next dispatch.
+        if (hasRay) pushRay(slot, state.pending, ray);
+        if (!done) atomicAdd(counters[SNELL_COUNTER_UNFINISHED], 1u);
     }
+    // Under a loop budget the next dispatch resumes every invocation, those
+    // whose subgroup finished included: each leaves its state, done or not.
+    if (LOOP_BUDGET != 0u) slotStates[slot] = state;
     if (COUNT_RAYS) {
-        for (int k = 0; k < SNELL_RAY_COUNTER_COUNT; ++k)
+        [[unroll]] for (int k = 0; k < SNELL_RAY_COUNTER_COUNT; ++k)
             if (countedRays[k] != 0u) atomicAdd(counters[k], countedRays[k]);
     }
     // Past the driver's limit some loop may have been cut short: say so.

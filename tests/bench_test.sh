@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# `snell bench --quick` works and its numbers are sane (issue 5): the CSV,
+# `snell bench --quick` works and its numbers are sane: the CSV,
 # JSON and SVG are written; every setting rendered, with a positive time and
 # finite error; the default settings stay within 0.5/255 of the exact image;
 # the ceiling, the peers and the scaling curve are there. Not a timed test.

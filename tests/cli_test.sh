@@ -78,13 +78,15 @@ wait $pid; status=$?
   bad "interrupted render (status $status): $(ls "$work")"
 
 # A GPU that fails mid-render (simulated by the SNELL_INJECT_FAULT hook): the
-# device is lost after the first band of rows has been streamed, or memory runs
-# out while the render allocates its tiles. Status 1, a message saying what
-# happened, the existing output untouched, no temporary left; the validation
-# layer sees the cleanup and must stay silent.
-for fault in device-lost:20 out-of-device-memory:9; do
+# device is lost after the first band of rows has been streamed (1100² is 2x2
+# tiles; submissions: the driver probe, the pipeline's first dispatch, then a
+# dispatch a tile, so the 6th is the last tile's), or memory runs out while
+# the render allocates its buffers. Status 1, a message saying what happened,
+# the existing output untouched, no temporary left; the validation layer sees
+# the cleanup and must stay silent.
+for fault in device-lost:6 out-of-device-memory:9; do
   echo "precious" >"$work/fault.png"
-  SNELL_INJECT_FAULT=$fault SNELL_VALIDATION=1 "$SNELL" render "$SCENES/showcase.scn" --size 600 -o "$work/fault.png" \
+  SNELL_INJECT_FAULT=$fault SNELL_VALIDATION=1 "$SNELL" render "$SCENES/basic.scn" --size 1100 -o "$work/fault.png" \
     2>"$work/err"; status=$?
   case $fault in device-lost*) want="device was lost";; *) want="ran out of memory";; esac
   [ $status -eq 1 ] && grep -q "$want" "$work/err" && grep -q "no image was written" "$work/err" &&

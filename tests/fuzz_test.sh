@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Short fuzzing runs for CI (issue 6): each libFuzzer target for
+# Short fuzzing runs for CI: each libFuzzer target for
 # ${FUZZ_SECONDS:-60} seconds, seeded from scenes/ and tests/bad/. Any crash,
 # sanitizer report or timeout fails; its input is left in build-fuzz/findings/
 # to become a test in tests/bad/.

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The preview window (issue 3) through a real X server (Xvfb), window and
+# The preview window through a real X server (Xvfb), window and
 # swapchain, with the Khronos validation layer on: the scripted screenshot of
 # a scene with reflection and refraction equals `snell render` of it (within
 # the GPU-vs-CPU thresholds), an orbit changes it, saving the scene file

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstddef>
 #include <set>
@@ -16,26 +17,33 @@ namespace {
 namespace gpu = snell::gpu;
 
 TEST(Layout, Sphere) {
-    EXPECT_EQ(sizeof(gpu::Sphere), 48u);
+    EXPECT_EQ(sizeof(gpu::Sphere), 32u);
     EXPECT_EQ(offsetof(gpu::Sphere, anchorRadius), 0u);
     EXPECT_EQ(offsetof(gpu::Sphere, normal), 16u);
-    EXPECT_EQ(offsetof(gpu::Sphere, material), 32u);
-    EXPECT_EQ(offsetof(gpu::Sphere, ellipsoid), 36u);
-    EXPECT_EQ(offsetof(gpu::Sphere, pad0), 40u);
-    EXPECT_EQ(offsetof(gpu::Sphere, pad1), 44u);
+    EXPECT_EQ(sizeof(gpu::UnrolledSpheres), 32u * SNELL_MAX_UNROLLED_SPHERES);
 }
+
+// An ellipsoid's sphere carries −1 − its index in anchorRadius.w.
+bool isEllipsoid(const gpu::Sphere& s) { return s.anchorRadius.w < 0.0f; }
+std::uint32_t ellipsoidIndex(const gpu::Sphere& s) { return static_cast<std::uint32_t>(-s.anchorRadius.w) - 1; }
 
 // A GPU sphere's centre: anchor − r·n0 for a true sphere, the stored centre
 // of an ellipsoid.
 glm::vec3 centreOf(const gpu::Sphere& s) {
-    if (s.ellipsoid != SNELL_NOT_ELLIPSOID) return glm::vec3(s.anchorRadius);
+    if (isEllipsoid(s)) return glm::vec3(s.anchorRadius);
     return glm::vec3(s.anchorRadius) - s.anchorRadius.w * glm::vec3(s.normal);
 }
 
+// An ellipsoid's objectFromWorld, from its three rows.
+glm::mat4 matrixOf(const gpu::Ellipsoid& e) {
+    return glm::transpose(glm::mat4(e.row0, e.row1, e.row2, glm::vec4(0, 0, 0, 1)));
+}
+
 TEST(Layout, Ellipsoid) {
-    EXPECT_EQ(sizeof(gpu::Ellipsoid), 64u);
-    EXPECT_EQ(offsetof(gpu::Ellipsoid, objectFromWorld), 0u);
-    EXPECT_EQ(sizeof(gpu::mat4), 64u);
+    EXPECT_EQ(sizeof(gpu::Ellipsoid), 48u);
+    EXPECT_EQ(offsetof(gpu::Ellipsoid, row0), 0u);
+    EXPECT_EQ(offsetof(gpu::Ellipsoid, row1), 16u);
+    EXPECT_EQ(offsetof(gpu::Ellipsoid, row2), 32u);
 }
 
 TEST(Layout, Material) {
@@ -52,14 +60,14 @@ TEST(Layout, Light) {
 }
 
 TEST(Layout, BvhNode) {
-    EXPECT_EQ(sizeof(gpu::BvhNode), 48u);
+    EXPECT_EQ(sizeof(gpu::BvhNode), 32u);
     EXPECT_EQ(offsetof(gpu::BvhNode, lower), 0u);
     EXPECT_EQ(offsetof(gpu::BvhNode, upper), 16u);
-    EXPECT_EQ(offsetof(gpu::BvhNode, first), 32u);
-    EXPECT_EQ(offsetof(gpu::BvhNode, count), 36u);
-    EXPECT_EQ(offsetof(gpu::BvhNode, skip), 40u);
-    EXPECT_EQ(offsetof(gpu::BvhNode, pad0), 44u);
 }
+
+// A node's links, stored as uint bits in the corners' w.
+std::uint32_t skipOf(const gpu::BvhNode& n) { return std::bit_cast<std::uint32_t>(n.lower.w); }
+std::uint32_t codeOf(const gpu::BvhNode& n) { return std::bit_cast<std::uint32_t>(n.upper.w); }
 
 TEST(Layout, FrameParams) {
     EXPECT_EQ(sizeof(gpu::FrameParams), 144u);
@@ -81,11 +89,25 @@ TEST(Layout, FrameParams) {
 }
 
 TEST(Layout, TileParams) {
-    EXPECT_EQ(sizeof(gpu::TileParams), 16u);
+    EXPECT_EQ(sizeof(gpu::TileParams), 32u);
     EXPECT_EQ(offsetof(gpu::TileParams, originX), 0u);
     EXPECT_EQ(offsetof(gpu::TileParams, originY), 4u);
     EXPECT_EQ(offsetof(gpu::TileParams, width), 8u);
     EXPECT_EQ(offsetof(gpu::TileParams, height), 12u);
+    EXPECT_EQ(offsetof(gpu::TileParams, resume), 16u);
+    EXPECT_EQ(offsetof(gpu::TileParams, stepX), 20u);
+    EXPECT_EQ(offsetof(gpu::TileParams, stepY), 24u);
+}
+
+TEST(Layout, SlotStateAndPendingRay) {
+    EXPECT_EQ(sizeof(gpu::SlotState), 32u);
+    EXPECT_EQ(offsetof(gpu::SlotState, pixel), 16u);
+    EXPECT_EQ(offsetof(gpu::SlotState, finished), 28u);
+    EXPECT_EQ(sizeof(gpu::PendingRay), 64u);
+    EXPECT_EQ(offsetof(gpu::PendingRay, weight), 32u);
+    EXPECT_EQ(offsetof(gpu::PendingRay, depth), 48u);
+    EXPECT_EQ(offsetof(gpu::PendingRay, flags), 56u);
+    EXPECT_EQ(offsetof(gpu::PendingRay, resumeShading), 60u);
 }
 
 TEST(Layout, ArrayStridesAreVec4Multiples) {
@@ -97,7 +119,6 @@ TEST(Layout, ArrayStridesAreVec4Multiples) {
     EXPECT_EQ(sizeof(gpu::BvhNode) % 16, 0u);
     EXPECT_EQ(sizeof(gpu::vec4), 16u);
     EXPECT_EQ(sizeof(gpu::uint), 4u);
-    EXPECT_EQ(SNELL_NOT_ELLIPSOID, 0xffffffffu);
 }
 
 // ---------------------------------------------------------------- buildGpuScene
@@ -132,34 +153,37 @@ TEST(GpuScene, SmallSceneIsOriginRelativeAndClassified) {
 
     // True sphere: centre (1,2,3), radius 2, anchored at its point nearest the
     // origin with the outward normal there.
-    EXPECT_EQ(g.spheres[0].ellipsoid, SNELL_NOT_ELLIPSOID);
+    EXPECT_FALSE(isEllipsoid(g.spheres[0]));
     EXPECT_FLOAT_EQ(g.spheres[0].anchorRadius.w, 2.0f);
     const glm::vec3 c0 = rel(1, 2, 3);
     const glm::vec3 n0 = -glm::normalize(c0);
     EXPECT_NEAR(glm::length(glm::vec3(g.spheres[0].normal) - n0), 0.0f, 1e-6f);
     EXPECT_NEAR(glm::length(glm::vec3(g.spheres[0].anchorRadius) - (c0 + 2.0f * n0)), 0.0f, 1e-6f);
     EXPECT_NEAR(glm::length(centreOf(g.spheres[0]) - c0), 0.0f, 1e-5f);
-    // Ellipsoid: centre and bounding radius, and its matrix.
+    EXPECT_NEAR(g.spheres[0].normal.w, glm::length(c0 + 2.0f * n0), 1e-5f);  // |P0|
+    // Ellipsoid: its centre and index, the norm of its matrix, and the matrix.
     ASSERT_EQ(g.ellipsoids.size(), 1u);
-    EXPECT_EQ(g.spheres[1].ellipsoid, 0u);
+    ASSERT_TRUE(isEllipsoid(g.spheres[1]));
+    EXPECT_EQ(ellipsoidIndex(g.spheres[1]), 0u);
     EXPECT_NEAR(glm::length(centreOf(g.spheres[1]) - rel(1, 2, 3)), 0.0f, 1e-6f);
-    EXPECT_GE(g.spheres[1].anchorRadius.w, 2.0f);
+    EXPECT_FLOAT_EQ(g.spheres[1].normal.w, 1.0f);  // diag(1, 1/2, 1): largest row sum 1
     // Its matrix maps origin-relative points to object space: the world point
     // (1, 4, 3) is the top of the ellipsoid.
-    const glm::vec4 top = g.ellipsoids[0].objectFromWorld * glm::vec4(rel(1, 4, 3), 1);
+    const glm::vec4 top = matrixOf(g.ellipsoids[0]) * glm::vec4(rel(1, 4, 3), 1);
     EXPECT_NEAR(top.x, 0.0f, 1e-6f);
     EXPECT_NEAR(top.y, 1.0f, 1e-6f);
     EXPECT_NEAR(top.z, 0.0f, 1e-6f);
-    const glm::vec4 centre = g.ellipsoids[0].objectFromWorld * glm::vec4(rel(1, 2, 3), 1);
+    const glm::vec4 centre = matrixOf(g.ellipsoids[0]) * glm::vec4(rel(1, 2, 3), 1);
     EXPECT_NEAR(glm::length(glm::vec3(centre)), 0.0f, 1e-6f);
 
     // Materials and lights.
     ASSERT_EQ(g.materials.size(), s.materials.size());
-    const gpu::Material& glass = g.materials[g.spheres[0].material];
+    ASSERT_EQ(g.sphereMaterials.size(), 2u);
+    const gpu::Material& glass = g.materials[g.sphereMaterials[0]];
     expectVec(glass.kd, 0.1f, 0.2f, 0.3f, 7.0f);  // w = Phong exponent
     EXPECT_FLOAT_EQ(glass.ks.y, 0.5f);
     expectVec(glass.kt, 0.3f, 0.3f, 0.3f, 1.5f);  // w = eta
-    const gpu::Material& plain = g.materials[g.spheres[1].material];
+    const gpu::Material& plain = g.materials[g.sphereMaterials[1]];
     expectVec(plain.kd, 1, 1, 1, 1);
     EXPECT_FLOAT_EQ(plain.kt.w, static_cast<float>(snell::kAirEta));
     EXPECT_EQ(g.refractiveSpheres, 1u);
@@ -223,43 +247,48 @@ TEST(GpuScene, BvhAboveTheThresholdHoldsEverySphereOnce) {
         std::set<std::uint32_t> ellipsoidIndices;
         for (const gpu::Sphere& sp : g.spheres) {
             seen.insert(static_cast<int>(std::lround(centreOf(sp).x / 3.0f)));
-            const bool isEllipsoid = sp.ellipsoid != SNELL_NOT_ELLIPSOID;
             const int index = static_cast<int>(std::lround(centreOf(sp).x / 3.0f)) - 1;
-            EXPECT_EQ(isEllipsoid, index % 3 == 2) << "sphere at x = " << centreOf(sp).x;
-            if (isEllipsoid) {
-                ASSERT_LT(sp.ellipsoid, g.ellipsoids.size());
-                EXPECT_TRUE(ellipsoidIndices.insert(sp.ellipsoid).second);
+            EXPECT_EQ(isEllipsoid(sp), index % 3 == 2) << "sphere at x = " << centreOf(sp).x;
+            if (isEllipsoid(sp)) {
+                const std::uint32_t e = ellipsoidIndex(sp);
+                ASSERT_LT(e, g.ellipsoids.size());
+                EXPECT_TRUE(ellipsoidIndices.insert(e).second);
                 // The ellipsoid's matrix belongs to this sphere: it maps its centre to 0.
-                const glm::vec4 c = g.ellipsoids[sp.ellipsoid].objectFromWorld *
-                                    glm::vec4(centreOf(sp), 1.0f);
+                const glm::vec4 c = matrixOf(g.ellipsoids[e]) * glm::vec4(centreOf(sp), 1.0f);
                 EXPECT_NEAR(glm::length(glm::vec3(c)), 0.0f, 1e-4f);
             }
         }
         for (std::size_t i = 1; i <= n; ++i) EXPECT_EQ(seen.count(static_cast<int>(i)), 1u) << i;
 
-        // Walked as the shader walks it (depth-first order, every box entered:
-        // next node for an inner node, skip after a leaf), the leaves cover
-        // [0, n) exactly once, each node is visited once, skips only go forward
-        // and each leaf's box contains its spheres' bounds.
+        // Walked in depth-first order, every box entered (next node for an
+        // inner node, skip after a leaf), the leaves cover [0, n) exactly
+        // once, each node is visited once, skips only go forward, an inner
+        // node's second child (its first child's skip) is a node, and each
+        // leaf's box contains its spheres' bounds.
         std::vector<int> covered(n, 0);
         std::size_t visited = 0;
+        EXPECT_GE(g.bvhDepth, 2);
         for (std::uint32_t i = 0; i < g.nodes.size();) {
             ASSERT_LE(++visited, g.nodes.size());
             const gpu::BvhNode& node = g.nodes[i];
-            ASSERT_GT(node.skip, i);
-            ASSERT_LE(node.skip, g.nodes.size());
-            if (node.count == 0) {
+            ASSERT_GT(skipOf(node), i);
+            ASSERT_LE(skipOf(node), g.nodes.size());
+            const std::uint32_t code = codeOf(node);
+            if (code == SNELL_BVH_INNER) {
+                ASSERT_LT(skipOf(g.nodes[i + 1]), g.nodes.size());
                 ++i;
                 continue;
             }
-            i = node.skip;
-            for (std::uint32_t k = node.first; k < node.first + node.count; ++k) {
+            i = skipOf(node);
+            const std::uint32_t first = code >> 2, count = (code & 3) + 1;
+            ASSERT_LE(count, std::uint32_t(SNELL_BVH_MAX_LEAF));
+            for (std::uint32_t k = first; k < first + count; ++k) {
                 ASSERT_LT(k, n);
                 ++covered[k];
                 const glm::vec4 cr(centreOf(g.spheres[k]), g.spheres[k].anchorRadius.w);
                 // A true sphere's radius is exact; an ellipsoid's only bounds
                 // it, so only its centre is checked.
-                const float r = g.spheres[k].ellipsoid == SNELL_NOT_ELLIPSOID ? cr.w : 0.0f;
+                const float r = isEllipsoid(g.spheres[k]) ? 0.0f : cr.w;
                 for (int a = 0; a < 3; ++a) {
                     EXPECT_LE(node.lower[a], cr[a] - r + 1e-5f);
                     EXPECT_GE(node.upper[a], cr[a] + r - 1e-5f);

@@ -377,7 +377,7 @@ void runBench(const BenchOptions& o, std::ostream& log) {
                 if (!renderer)
                     renderer = std::make_unique<ComputeRenderer>(context, scene, base.camera, setting.precision,
                                                                  setting.bvh);
-                r.bvhUsed = !renderer->layout().nodes.empty();
+                r.bvhUsed = renderer->layout().usesBvh();
                 renderer->render(request, false);  // warm-up: pipeline and first dispatch
                 std::vector<double> ms;
                 Image image;
@@ -498,11 +498,7 @@ void runBench(const BenchOptions& o, std::ostream& log) {
         ComputeRenderer renderer(context, scene, request.camera);
         s.uploadMs = renderer.uploadMs();
         s.bvhBuildMs = renderer.layout().bvhBuildMs;
-        const gpu::GpuScene& l = renderer.layout();
-        s.gpuMiB = double(l.spheres.size() * sizeof(gpu::Sphere) + l.nodes.size() * sizeof(gpu::BvhNode) +
-                          l.ellipsoids.size() * sizeof(gpu::Ellipsoid) + l.materials.size() * sizeof(gpu::Material) +
-                          l.lights.size() * sizeof(gpu::Light)) /
-                   (1 << 20);
+        s.gpuMiB = double(renderer.layout().bytes()) / (1 << 20);
         renderer.render(request, false);
         std::vector<double> ms;
         for (int k = 0; k < (e >= 5 ? 3 : runs); ++k) ms.push_back(renderer.render(request, false).renderMs);

@@ -1,4 +1,4 @@
-// `snell bench` (issue 5): speed against error. For each scene it sweeps the
+// `snell bench`: speed against error. For each scene it sweeps the
 // renderer's settings (depth, weight cut-off, precision, BVH, supersampling),
 // times the dispatches by GPU timestamps (median and range of several runs
 // after a warm-up), measures the error against the converged CPU reference,

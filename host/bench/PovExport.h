@@ -1,4 +1,4 @@
-// A scene in POV-Ray 3.7's language, for the benchmark's peer (issue 5):
+// A scene in POV-Ray 3.7's language, for the benchmark's peer:
 // the same camera, spheres (through their full matrices), lights and
 // background, Phong terms, mirror reflection and refraction, traced to
 // `maxTraceLevel` with adc_bailout 0. POV-Ray's shading model differs from

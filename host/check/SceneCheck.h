@@ -1,5 +1,5 @@
 // `snell check`: what a scene holds and what looks wrong in it, without
-// rendering (issue 7). No Vulkan.
+// rendering. No Vulkan.
 #pragma once
 
 #include <string>

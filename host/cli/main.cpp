@@ -67,6 +67,7 @@ struct RenderOptions {
     bool verbose = false;
     bool validation = false;
     snell::vk::FaultInjection fault;  // $SNELL_INJECT_FAULT, for tests
+    std::uint32_t loopBudget = 0;     // $SNELL_LOOP_BUDGET, for tests
 };
 
 // A progress line on stderr, only when stderr is a terminal.
@@ -200,6 +201,7 @@ int runRender(const RenderOptions& o) {
                 context, scene, request.camera,
                 o.precision == "fp64" ? snell::gpu::Precision::Fp64 : snell::gpu::Precision::Fp32);
             uploadMs = renderer.uploadMs();
+            if (o.loopBudget > 0) renderer.forceLoopBudget(o.loopBudget);
             snell::GpuRenderResult r = renderer.render(request, o.stats);
             rays = r.rays;
             renderMs = r.renderMs;
@@ -487,6 +489,17 @@ int main(int argc, char** argv) {
             std::cerr << "snell: error: SNELL_INJECT_FAULT: " << e.what() << "\n";
             return kExitInput;
         }
+    }
+    // Another: run the shader's suspend-and-resume path with this loop budget.
+    if (const char* budget = std::getenv("SNELL_LOOP_BUDGET"); budget && *budget) {
+        char* end = nullptr;
+        const unsigned long value = std::strtoul(budget, &end, 10);
+        if (*end != '\0' || value == 0 || value > SNELL_LOOP_BUDGET_LIMITED) {
+            std::cerr << "snell: error: SNELL_LOOP_BUDGET: expected a loop budget from 1 to "
+                      << SNELL_LOOP_BUDGET_LIMITED << ", not '" << budget << "'\n";
+            return kExitInput;
+        }
+        ro.loopBudget = static_cast<std::uint32_t>(value);
     }
     if (render->parsed()) return runRender(ro);
     if (bench->parsed()) return runBenchCommand(bo);

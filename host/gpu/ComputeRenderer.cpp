@@ -5,14 +5,15 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <thread>
 
+#include "gpu/DriverProbe.h"
 #include "trace_comp_spv.h"       // generated at build time from shaders/trace.comp
 #include "trace_fp64_comp_spv.h"  // the same, compiled with SNELL_FP64
 
 namespace snell {
 
 using vk::check;
-using vk::imageBarrier;
 
 namespace {
 
@@ -22,6 +23,25 @@ double msSince(Clock::time_point start) {
 }
 
 constexpr VkBufferUsageFlags kStorage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+
+// The descriptor type of each binding of shared_layout.h.
+VkDescriptorType descriptorType(std::uint32_t binding) {
+    switch (binding) {
+    case SNELL_BINDING_FRAME:
+    case SNELL_BINDING_FRAME_LOW:
+    case SNELL_BINDING_SPHERE_BLOCK: return VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
+    case SNELL_BINDING_SPHERES:
+    case SNELL_BINDING_SPHERE_MATERIALS:
+    case SNELL_BINDING_ELLIPSOIDS:
+    case SNELL_BINDING_MATERIALS:
+    case SNELL_BINDING_LIGHTS:
+    case SNELL_BINDING_BVH:
+    case SNELL_BINDING_SPHERES_LOW:
+    case SNELL_BINDING_ELLIPSOIDS_LOW:
+    case SNELL_BINDING_LIGHTS_LOW: return VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
+    default: return VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    }
+}
 
 }  // namespace
 
@@ -36,7 +56,7 @@ struct ComputeRenderer::Pipeline {
     VkCommandPool commandPool = VK_NULL_HANDLE;
     VkCommandBuffer commands = VK_NULL_HANDLE;
     VkFence fence = VK_NULL_HANDLE;
-    vk::Buffer frame, counters, readback, pixelStates, rayStack, mediaStack;
+    vk::Buffer frame, counters, output, slotStates, rayStack, mediaStack;
     vk::Buffer frameLow, rayStackLow;  // fp64 only
     std::uint32_t rayStackDepth = 1;  // the RAY_STACK specialisation
     std::uint32_t maxMedia = 1;       // the MAX_MEDIA specialisation
@@ -44,8 +64,7 @@ struct ComputeRenderer::Pipeline {
     // What it was built for: kept between renders and reused while these match.
     Specialisation values{};
     int tileW = 0, tileH = 0;
-    bool imageReadable = false;  // the image is in TRANSFER_SRC layout (after a copy)
-    vk::StorageImage image;
+    std::uint32_t slots = 0;  // persistent invocations a dispatch
 };
 
 ComputeRenderer::ComputeRenderer(vk::Context& context, const Scene& scene, const Camera& camera,
@@ -57,25 +76,46 @@ ComputeRenderer::ComputeRenderer(vk::Context& context, const Scene& scene, const
                               " lacks; use --precision fp32, or another device (--gpu; lavapipe has them)");
     const auto start = Clock::now();
     layout_ = gpu::buildGpuScene(scene, camera, precision, bvh);
-    const VkDeviceSize limit = context.properties().limits.maxStorageBufferRange;
-    auto upload = [&](const auto& v, const char* what) {
+    loopBudget_ = limitsLoopIterations(context) ? SNELL_LOOP_BUDGET_LIMITED : 0u;
+    // Each scene array becomes a texel buffer (shared_layout.h): its structs
+    // are runs of RGBA32 texels (R32 for a uint array).
+    const VkDeviceSize maxTexels = context.properties().limits.maxTexelBufferElements;
+    auto upload = [&](std::uint32_t binding, const auto& v, VkFormat format, const char* what) {
         const VkDeviceSize bytes = v.size() * sizeof(v[0]);
-        if (bytes > limit)
-            throw vk::VulkanError(std::string("the scene's ") + what + " need " + std::to_string(bytes >> 20) +
-                                  " MiB, more than this device's storage-buffer limit of " +
-                                  std::to_string(limit >> 20) + " MiB");
-        return context_.createBufferWithData(v.data(), bytes, kStorage);
+        const VkDeviceSize texelBytes = format == VK_FORMAT_R32_UINT ? 4 : 16;
+        if (bytes / texelBytes > maxTexels)
+            throw vk::VulkanError(std::string("the scene's ") + what + " need " + std::to_string(bytes / texelBytes) +
+                                  " texels, more than this device's texel-buffer limit of " +
+                                  std::to_string(maxTexels));
+        sceneBuffers_[binding] = context_.createBufferWithData(v.data(), bytes, VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT);
+        VkBufferViewCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_VIEW_CREATE_INFO};
+        info.buffer = sceneBuffers_[binding].buffer;
+        info.format = format;
+        info.range = VK_WHOLE_SIZE;
+        check(vkCreateBufferView(context_.device(), &info, nullptr, &sceneViews_[binding]), "vkCreateBufferView");
     };
     try {
-        spheres_ = upload(layout_.spheres, "spheres");
-        ellipsoids_ = upload(layout_.ellipsoids, "ellipsoids");
-        materials_ = upload(layout_.materials, "materials");
-        lights_ = upload(layout_.lights, "lights");
-        nodes_ = upload(layout_.nodes, "BVH nodes");
+        constexpr VkFormat rgba = VK_FORMAT_R32G32B32A32_SFLOAT;
+        upload(SNELL_BINDING_SPHERES, layout_.spheres, rgba, "spheres");
+        upload(SNELL_BINDING_SPHERE_MATERIALS, layout_.sphereMaterials, VK_FORMAT_R32_UINT, "spheres");
+        upload(SNELL_BINDING_ELLIPSOIDS, layout_.ellipsoids, rgba, "ellipsoids");
+        upload(SNELL_BINDING_MATERIALS, layout_.materials, rgba, "materials");
+        upload(SNELL_BINDING_LIGHTS, layout_.lights, rgba, "lights");
+        upload(SNELL_BINDING_BVH, layout_.nodes, VK_FORMAT_R32G32B32A32_UINT, "BVH nodes");
+        // Small scenes: the spheres again, as a uniform block (shared_layout.h);
+        // for fp64 their low parts follow in the same buffer.
+        std::array<gpu::UnrolledSpheres, 2> blocks{};
+        if (!layout_.usesBvh() && layout_.spheres.size() <= SNELL_MAX_UNROLLED_SPHERES) {
+            std::copy(layout_.spheres.begin(), layout_.spheres.end(), blocks[0].spheres);
+            std::copy(layout_.sphereLows.begin(), layout_.sphereLows.end(), blocks[1].spheres);
+        }
+        const std::size_t blockBytes = (precision == gpu::Precision::Fp64 ? 2 : 1) * sizeof(gpu::UnrolledSpheres);
+        sceneBuffers_[SNELL_BINDING_SPHERE_BLOCK] =
+            context_.createBufferWithData(blocks.data(), blockBytes, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
         if (precision == gpu::Precision::Fp64) {
-            sphereLows_ = upload(layout_.sphereLows, "spheres");
-            ellipsoidLows_ = upload(layout_.ellipsoidLows, "ellipsoids");
-            lightLows_ = upload(layout_.lightLows, "lights");
+            upload(SNELL_BINDING_SPHERES_LOW, layout_.sphereLows, rgba, "spheres");
+            upload(SNELL_BINDING_ELLIPSOIDS_LOW, layout_.ellipsoidLows, rgba, "ellipsoids");
+            upload(SNELL_BINDING_LIGHTS_LOW, layout_.lightLows, rgba, "lights");
         }
     } catch (...) {
         destroyBuffers();
@@ -90,9 +130,11 @@ ComputeRenderer::~ComputeRenderer() {
 }
 
 void ComputeRenderer::destroyBuffers() {
-    for (vk::Buffer* b :
-         {&spheres_, &ellipsoids_, &materials_, &lights_, &nodes_, &sphereLows_, &ellipsoidLows_, &lightLows_})
-        context_.destroy(*b);
+    for (VkBufferView& v : sceneViews_) {
+        if (v) vkDestroyBufferView(context_.device(), v, nullptr);
+        v = VK_NULL_HANDLE;
+    }
+    for (vk::Buffer& b : sceneBuffers_) context_.destroy(b);
 }
 
 ComputeRenderer::Specialisation ComputeRenderer::specialise(const RenderRequest& request, bool countRays) const {
@@ -100,7 +142,10 @@ ComputeRenderer::Specialisation ComputeRenderer::specialise(const RenderRequest&
     const bool hasRefraction = layout_.refractiveSpheres > 0 && request.trace.refraction;
     const bool hasReflection = scene_.anyReflection() && request.trace.reflection;
     Specialisation values{};
-    values[SNELL_SPEC_USE_BVH] = !layout_.nodes.empty();
+    values[SNELL_SPEC_USE_BVH] = layout_.usesBvh();
+    const bool unrolled = !layout_.usesBvh() && layout_.spheres.size() <= SNELL_MAX_UNROLLED_SPHERES;
+    values[SNELL_SPEC_SPHERE_COUNT] = unrolled ? static_cast<std::uint32_t>(layout_.spheres.size()) : 0u;
+    values[SNELL_SPEC_BVH_DEPTH] = static_cast<std::uint32_t>(std::max(1, layout_.bvhDepth));
     values[SNELL_SPEC_HAS_ELLIPSOIDS] = !layout_.ellipsoids.empty();
     values[SNELL_SPEC_HAS_REFRACTION] = hasRefraction;
     values[SNELL_SPEC_HAS_REFLECTION] = hasReflection;
@@ -114,7 +159,7 @@ ComputeRenderer::Specialisation ComputeRenderer::specialise(const RenderRequest&
     // most one child, traced at once: only a suspended ray ever waits.
     values[SNELL_SPEC_RAY_STACK] = static_cast<std::uint32_t>(hasRefraction ? request.trace.maxDepth + 1 : 1);
     values[SNELL_SPEC_AMPLIFYING] = layout_.amplifying;
-    values[SNELL_SPEC_LOOP_BUDGET] = context_.isLlvmpipe() ? SNELL_LOOP_BUDGET_LLVMPIPE : 0u;
+    values[SNELL_SPEC_LOOP_BUDGET] = loopBudget_;
     return values;
 }
 
@@ -128,11 +173,8 @@ void ComputeRenderer::createPipeline(const Specialisation& values, Pipeline& p) 
         bindings[i].binding = i;
         bindings[i].descriptorCount = 1;
         bindings[i].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
-        bindings[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+        bindings[i].descriptorType = descriptorType(i);
     }
-    bindings[SNELL_BINDING_OUTPUT_IMAGE].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
-    bindings[SNELL_BINDING_FRAME].descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
-    bindings[SNELL_BINDING_FRAME_LOW].descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
     VkDescriptorSetLayoutCreateInfo setInfo{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
     setInfo.bindingCount = p.bindingCount;
     setInfo.pBindings = bindings.data();
@@ -168,10 +210,12 @@ void ComputeRenderer::createPipeline(const Specialisation& values, Pipeline& p) 
     check(vkCreateComputePipelines(device, context_.pipelineCache(), 1, &pipelineInfo, nullptr, &p.pipeline),
           "vkCreateComputePipelines");
 
-    const std::uint32_t uniformBuffers = wide ? 2 : 1;
-    std::array<VkDescriptorPoolSize, 3> sizes{{{VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1},
-                                               {VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, uniformBuffers},
-                                               {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, p.bindingCount - 1 - uniformBuffers}}};
+    std::array<VkDescriptorPoolSize, 3> sizes{{{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 0},
+                                               {VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, 0},
+                                               {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 0}}};
+    for (std::uint32_t i = 0; i < p.bindingCount; ++i)
+        for (VkDescriptorPoolSize& size : sizes)
+            if (size.type == descriptorType(i)) ++size.descriptorCount;
     VkDescriptorPoolCreateInfo poolInfo{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
     poolInfo.maxSets = 1;
     poolInfo.poolSizeCount = static_cast<std::uint32_t>(sizes.size());
@@ -215,13 +259,12 @@ void ComputeRenderer::destroyPipeline(Pipeline& p) {
     if (p.setLayout) vkDestroyDescriptorSetLayout(device, p.setLayout, nullptr);
     context_.destroy(p.frame);
     context_.destroy(p.counters);
-    context_.destroy(p.readback);
-    context_.destroy(p.pixelStates);
+    context_.destroy(p.output);
+    context_.destroy(p.slotStates);
     context_.destroy(p.rayStack);
     context_.destroy(p.mediaStack);
     context_.destroy(p.frameLow);
     context_.destroy(p.rayStackLow);
-    context_.destroy(p.image);
 }
 
 namespace {
@@ -234,8 +277,13 @@ void memoryBarrier(VkCommandBuffer cmd, VkAccessFlags srcAccess, VkAccessFlags d
     vkCmdPipelineBarrier(cmd, srcStage, dstStage, 0, 1, &b, 0, nullptr, 0, nullptr);
 }
 
-// Device memory for the pixels' suspended ray trees, per tile.
-constexpr VkDeviceSize kTileStateBudget = 64ull << 20;
+// Device memory for the invocations' ray stacks.
+constexpr VkDeviceSize kStackBudget = 64ull << 20;
+// The largest tile side: an image is rendered (and streamed) tile by tile.
+constexpr int kMaxTileSide = 1024;
+// Workgroups of persistent invocations per core on a CPU device (lavapipe):
+// enough that the cores finish together.
+constexpr unsigned kCpuWorkgroupsPerCore = 8;
 
 }  // namespace
 
@@ -247,29 +295,38 @@ GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool count
         const auto pipelineStart = Clock::now();
         const Specialisation values = specialise(request, countRays);
 
-        // Tiles: square, a multiple of the workgroup, as large as the memory for
-        // the pixels' ray stacks allows (at most 1024²).
+        // Tiles: square, at most kMaxTileSide (16 MiB of float image).
         const int s = std::max(1, request.supersample);
         const bool wide = layout_.precision == gpu::Precision::Fp64;  // a low part per pending ray too
-        const VkDeviceSize bytesPerPixel =
-            sizeof(gpu::PixelState) + VkDeviceSize(values[SNELL_SPEC_RAY_STACK]) *
-                                          ((wide ? 2 : 1) * sizeof(gpu::PendingRay) + values[SNELL_SPEC_MAX_MEDIA] * 4);
+        const int tileW = std::min(kMaxTileSide, request.width);
+        const int tileH = std::min(kMaxTileSide, request.height);
+        // Persistent invocations (trace.comp): on a CPU device a few workgroups
+        // per core keep every core busy to the end of the dispatch; on a GPU
+        // one per pixel, as many as the memory for their ray stacks allows.
+        const VkDeviceSize bytesPerSlot =
+            sizeof(gpu::SlotState) + VkDeviceSize(values[SNELL_SPEC_RAY_STACK]) *
+                                         ((wide ? 2 : 1) * sizeof(gpu::PendingRay) + values[SNELL_SPEC_MAX_MEDIA] * 4);
         const VkDeviceSize limit = context_.properties().limits.maxStorageBufferRange;
-        const VkDeviceSize maxPixels = std::min(kTileStateBudget, limit) / bytesPerPixel;
-        const int tileSide = std::clamp(static_cast<int>(std::sqrt(double(maxPixels))) / 8 * 8, 8, 1024);
-        const int tileW = std::min(tileSide, request.width);
-        const int tileH = std::min(tileSide, request.height);
         const VkDeviceSize tilePixels = VkDeviceSize(tileW) * tileH;
+        VkDeviceSize slots = std::min(kStackBudget, limit) / bytesPerSlot;
+        if (context_.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU)
+            slots = std::min<VkDeviceSize>(slots, SNELL_WORKGROUP_SIZE * kCpuWorkgroupsPerCore *
+                                                      std::max(1u, std::thread::hardware_concurrency()));
+        slots = std::clamp<VkDeviceSize>(std::min(slots, tilePixels) / SNELL_WORKGROUP_SIZE, 1, 65535) *
+                SNELL_WORKGROUP_SIZE;
+        result.invocations = static_cast<int>(slots);
 
         // The pipeline and the tile's buffers of the last render serve again
         // when the specialisation and tile size are the same (the preview).
-        const bool reuse = cached_ && cached_->values == values && cached_->tileW == tileW && cached_->tileH == tileH;
+        const bool reuse = cached_ && cached_->values == values && cached_->tileW == tileW &&
+                           cached_->tileH == tileH && cached_->slots == slots;
         if (!reuse) {
             if (cached_) destroyPipeline(*cached_);
             cached_ = std::make_unique<Pipeline>();
             createPipeline(values, *cached_);
             cached_->tileW = tileW;
             cached_->tileH = tileH;
+            cached_->slots = static_cast<std::uint32_t>(slots);
         }
         Pipeline& p = *cached_;
 
@@ -284,36 +341,26 @@ GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool count
             p.frameLow = context_.createBufferWithData(&frameLow, sizeof frameLow, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
         if (!reuse) {
             p.counters = context_.createBuffer(SNELL_COUNTER_COUNT * sizeof(std::uint32_t), kStorage, true);
-            p.pixelStates = context_.createBuffer(tilePixels * sizeof(gpu::PixelState),
-                                                  kStorage | VK_BUFFER_USAGE_TRANSFER_DST_BIT, false);
-            p.rayStack =
-                context_.createBuffer(tilePixels * p.rayStackDepth * sizeof(gpu::PendingRay), kStorage, false);
-            p.mediaStack = context_.createBuffer(tilePixels * p.rayStackDepth * p.maxMedia * 4, kStorage, false);
+            // Host-visible: the host reads the invocations' progress while they run.
+            p.slotStates = context_.createBuffer(slots * sizeof(gpu::SlotState), kStorage, true);
+            p.rayStack = context_.createBuffer(slots * p.rayStackDepth * sizeof(gpu::PendingRay), kStorage, false);
+            p.mediaStack = context_.createBuffer(slots * p.rayStackDepth * p.maxMedia * 4, kStorage, false);
             if (wide)
-                p.rayStackLow =
-                    context_.createBuffer(tilePixels * p.rayStackDepth * sizeof(gpu::PendingRay), kStorage, false);
-            p.image = context_.createStorageImage(tileW, tileH, VK_FORMAT_R32G32B32A32_SFLOAT);
-            p.readback = context_.createBuffer(VkDeviceSize(tileW) * tileH * 4 * sizeof(float),
-                                               VK_BUFFER_USAGE_TRANSFER_DST_BIT, true);
+                p.rayStackLow = context_.createBuffer(slots * p.rayStackDepth * sizeof(gpu::PendingRay), kStorage, false);
+            // The tile's pixels, which the host reads where the shader wrote them
+            // (on lavapipe, an imageStore in a loop costs 13x a buffer store).
+            p.output = context_.createBuffer(VkDeviceSize(tileW) * tileH * 4 * sizeof(float), kStorage, true);
         }
 
-        VkDescriptorImageInfo imageInfo{VK_NULL_HANDLE, p.image.view, VK_IMAGE_LAYOUT_GENERAL};
         std::array<VkDescriptorBufferInfo, SNELL_BINDING_COUNT> bufferInfo{};
         std::array<const vk::Buffer*, SNELL_BINDING_COUNT> buffers{};
+        buffers[SNELL_BINDING_OUTPUT] = &p.output;
         buffers[SNELL_BINDING_FRAME] = &p.frame;
-        buffers[SNELL_BINDING_SPHERES] = &spheres_;
-        buffers[SNELL_BINDING_ELLIPSOIDS] = &ellipsoids_;
-        buffers[SNELL_BINDING_MATERIALS] = &materials_;
-        buffers[SNELL_BINDING_LIGHTS] = &lights_;
-        buffers[SNELL_BINDING_BVH] = &nodes_;
         buffers[SNELL_BINDING_COUNTERS] = &p.counters;
-        buffers[SNELL_BINDING_PIXEL_STATES] = &p.pixelStates;
+        buffers[SNELL_BINDING_SLOT_STATES] = &p.slotStates;
         buffers[SNELL_BINDING_RAY_STACK] = &p.rayStack;
         buffers[SNELL_BINDING_MEDIA_STACK] = &p.mediaStack;
         buffers[SNELL_BINDING_FRAME_LOW] = &p.frameLow;
-        buffers[SNELL_BINDING_SPHERES_LOW] = &sphereLows_;
-        buffers[SNELL_BINDING_ELLIPSOIDS_LOW] = &ellipsoidLows_;
-        buffers[SNELL_BINDING_LIGHTS_LOW] = &lightLows_;
         buffers[SNELL_BINDING_RAY_STACK_LOW] = &p.rayStackLow;
         std::array<VkWriteDescriptorSet, SNELL_BINDING_COUNT> writes{};
         for (std::uint32_t i = 0; i < p.bindingCount; ++i) {
@@ -321,14 +368,12 @@ GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool count
             writes[i].dstSet = p.set;
             writes[i].dstBinding = i;
             writes[i].descriptorCount = 1;
-            if (i == SNELL_BINDING_OUTPUT_IMAGE) {
-                writes[i].descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_IMAGE;
-                writes[i].pImageInfo = &imageInfo;
+            writes[i].descriptorType = descriptorType(i);
+            if (writes[i].descriptorType == VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER) {
+                writes[i].pTexelBufferView = &sceneViews_[i];
             } else {
+                if (!buffers[i]) buffers[i] = &sceneBuffers_[i];
                 bufferInfo[i] = {buffers[i]->buffer, 0, VK_WHOLE_SIZE};
-                writes[i].descriptorType = (i == SNELL_BINDING_FRAME || i == SNELL_BINDING_FRAME_LOW)
-                                               ? VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER
-                                               : VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
                 writes[i].pBufferInfo = &bufferInfo[i];
             }
         }
@@ -373,12 +418,9 @@ GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool count
         // An empty dispatch first: llvmpipe compiles a shader at its first
         // dispatch, and that belongs to pipeline creation, not to the render.
         if (!reuse) {
-            const gpu::TileParams empty{0, 0, 0, 0};
+            const gpu::TileParams empty{};
             std::memset(p.counters.mapped, 0, SNELL_COUNTER_COUNT * sizeof(std::uint32_t));
             submit([](VkCommandBuffer) {}, [&](VkCommandBuffer cmd) {
-                imageBarrier(cmd, p.image.image, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_GENERAL, 0,
-                             VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT,
-                             VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
                 vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.pipeline);
                 vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.layout, 0, 1, &p.set, 0, nullptr);
                 vkCmdPushConstants(cmd, p.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof empty, &empty);
@@ -393,32 +435,26 @@ GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool count
         const int tilesY = (request.height + tileH - 1) / tileH;
         const int tileCount = tilesX * tilesY;
         auto* counters = static_cast<std::uint32_t*>(p.counters.mapped);
-        bool& imageUsed = p.imageReadable;
         for (int ty = 0; ty < tilesY; ++ty) {
             for (int tx = 0; tx < tilesX; ++tx) {
-                gpu::TileParams tile{std::uint32_t(tx * tileW), std::uint32_t(ty * tileH),
-                                     std::uint32_t(std::min(tileW, request.width - tx * tileW)),
-                                     std::uint32_t(std::min(tileH, request.height - ty * tileH))};
-                const std::uint32_t groupsX = (tile.width + SNELL_WORKGROUP_SIZE_X - 1) / SNELL_WORKGROUP_SIZE_X;
-                const std::uint32_t groupsY = (tile.height + SNELL_WORKGROUP_SIZE_Y - 1) / SNELL_WORKGROUP_SIZE_Y;
-                // Dispatch until every pixel of the tile has finished its ray
-                // trees; each dispatch resumes where the last one stopped.
+                gpu::TileParams tile{};
+                tile.originX = std::uint32_t(tx * tileW);
+                tile.originY = std::uint32_t(ty * tileH);
+                tile.width = std::uint32_t(std::min(tileW, request.width - tx * tileW));
+                tile.height = std::uint32_t(std::min(tileH, request.height - ty * tileH));
+                tile.stepX = std::uint32_t(slots % tile.width);
+                tile.stepY = std::uint32_t(slots / tile.width);
+                const std::uint32_t groups = std::uint32_t(slots / SNELL_WORKGROUP_SIZE);
+                // One dispatch renders the tile; where the driver limits loops,
+                // the invocations suspend and the next dispatch resumes them.
                 for (int pass = 0;; ++pass) {
                     if (request.cancel && request.cancel->load()) throw vk::VulkanError("render cancelled");
                     std::memset(counters, 0, SNELL_COUNTER_COUNT * sizeof(std::uint32_t));
+                    tile.resume = pass > 0 ? 1u : 0u;
+                    if (pass == 0) std::memset(p.slotStates.mapped, 0, slots * sizeof(gpu::SlotState));
                     submit([&](VkCommandBuffer cmd) {
-                        if (pass == 0) {
-                            vkCmdFillBuffer(cmd, p.pixelStates.buffer, 0, VK_WHOLE_SIZE, 0);
-                            memoryBarrier(cmd, VK_ACCESS_TRANSFER_WRITE_BIT,
-                                          VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT,
-                                          VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
-                            if (imageUsed)
-                                imageBarrier(cmd, p.image.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-                                             VK_IMAGE_LAYOUT_GENERAL, VK_ACCESS_TRANSFER_READ_BIT,
-                                             VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
-                                             VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
-                        } else {
-                            // The previous dispatch's pixel states and stacks.
+                        if (pass > 0) {
+                            // The previous dispatch's invocation states and stacks.
                             memoryBarrier(cmd, VK_ACCESS_SHADER_WRITE_BIT,
                                           VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT,
                                           VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
@@ -427,7 +463,7 @@ GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool count
                         vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.pipeline);
                         vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.layout, 0, 1, &p.set, 0, nullptr);
                         vkCmdPushConstants(cmd, p.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof tile, &tile);
-                        vkCmdDispatch(cmd, groupsX, groupsY, 1);
+                        vkCmdDispatch(cmd, groups, 1, 1);
                         memoryBarrier(cmd, VK_ACCESS_SHADER_WRITE_BIT, VK_ACCESS_HOST_READ_BIT,
                                       VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT);
                     }, true);
@@ -443,31 +479,22 @@ GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool count
                         result.rays.refracted += counters[SNELL_COUNTER_REFRACTED];
                     }
                     const std::uint32_t unfinished = counters[SNELL_COUNTER_UNFINISHED];
-                    if (request.progress)
-                        request.progress((result.tiles + 1.0 - double(unfinished) / double(tile.width * tile.height)) /
+                    if (request.progress) {
+                        std::uint64_t finished = 0;
+                        const auto* states = static_cast<const gpu::SlotState*>(p.slotStates.mapped);
+                        for (VkDeviceSize k = 0; k < slots; ++k) finished += states[k].finished;
+                        request.progress((result.tiles + double(finished) / double(tile.width * tile.height)) /
                                          tileCount);
+                    }
                     if (unfinished == 0) break;
                 }
-                // Copy the finished tile back.
-                submit([](VkCommandBuffer) {}, [&](VkCommandBuffer cmd) {
-                    imageBarrier(cmd, p.image.image, VK_IMAGE_LAYOUT_GENERAL, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-                                 VK_ACCESS_SHADER_WRITE_BIT, VK_ACCESS_TRANSFER_READ_BIT,
-                                 VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT);
-                    VkBufferImageCopy region{};
-                    region.bufferRowLength = tileW;
-                    region.imageSubresource = {VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1};
-                    region.imageExtent = {tile.width, tile.height, 1};
-                    vkCmdCopyImageToBuffer(cmd, p.image.image, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, p.readback.buffer,
-                                           1, &region);
-                    memoryBarrier(cmd, VK_ACCESS_TRANSFER_WRITE_BIT, VK_ACCESS_HOST_READ_BIT,
-                                  VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT);
-                }, false);
+                // The finished tile, from where the shader wrote it.
                 const auto readStart = Clock::now();
-                const auto* texels = static_cast<const float*>(p.readback.mapped);
+                const auto* texels = static_cast<const float*>(p.output.mapped);
                 for (std::uint32_t y = 0; y < tile.height; ++y) {
                     float* row = request.rowSink ? band.pixel(tile.originX, y)
                                                  : result.image.pixel(tile.originX, tile.originY + y);
-                    const float* src = texels + std::size_t(y) * tileW * 4;
+                    const float* src = texels + std::size_t(y) * tile.width * 4;
                     for (std::uint32_t x = 0; x < tile.width; ++x) {
                         row[x * 3 + 0] = src[x * 4 + 0];
                         row[x * 3 + 1] = src[x * 4 + 1];
@@ -475,7 +502,6 @@ GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool count
                     }
                 }
                 result.readbackMs += msSince(readStart);
-                imageUsed = true;
                 ++result.tiles;
             }
             if (request.rowSink) request.rowSink(band.rgb.data(), std::min(tileH, request.height - ty * tileH));

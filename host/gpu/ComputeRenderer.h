@@ -22,7 +22,8 @@ struct GpuRenderResult {
     double pipelineMs = 0.0;  // shader pipeline creation
     double readbackMs = 0.0;  // copying tiles back into the image
     int tiles = 0;
-    int dispatches = 0;       // pixels resume across dispatches (see shared_layout.h)
+    int dispatches = 0;       // more than one a tile where the driver limits loops (shared_layout.h)
+    int invocations = 0;      // persistent invocations a dispatch (trace.comp)
 };
 
 class ComputeRenderer {
@@ -43,6 +44,11 @@ public:
     // buffers are kept for the next render, which reuses them when it can.
     GpuRenderResult render(const RenderRequest& request, bool countRays);
 
+    // Testing: suspend and resume the invocations every `budget` loop
+    // iterations (SNELL_LOOP_BUDGET), as on a driver that limits loops,
+    // whatever this driver does. The image must not change.
+    void forceLoopBudget(std::uint32_t budget) { loopBudget_ = budget; }
+
 private:
     struct Pipeline;
     using Specialisation = std::array<std::uint32_t, SNELL_SPEC_COUNT>;
@@ -54,8 +60,10 @@ private:
     vk::Context& context_;
     const Scene& scene_;
     gpu::GpuScene layout_;
-    vk::Buffer spheres_, ellipsoids_, materials_, lights_, nodes_;
-    vk::Buffer sphereLows_, ellipsoidLows_, lightLows_;  // fp64 only
+    // The scene's buffers, by binding (shared_layout.h); the others stay empty.
+    std::array<vk::Buffer, SNELL_BINDING_COUNT> sceneBuffers_{};
+    std::array<VkBufferView, SNELL_BINDING_COUNT> sceneViews_{};
+    std::uint32_t loopBudget_ = 0;  // where the driver ends long loops (gpu/DriverProbe.h), else 0
     double uploadMs_ = 0.0;
     std::unique_ptr<Pipeline> cached_;  // the last render's, reused by the next when it fits
 };

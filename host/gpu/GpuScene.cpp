@@ -1,6 +1,7 @@
 #include "gpu/GpuScene.h"
 
 #include <algorithm>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -18,11 +19,6 @@ vec4 toVec4(const snell::dvec3& v, double w) {
 void splitVec4(const snell::dvec3& v, double w, vec4& hi, vec4& lo) {
     for (int k = 0; k < 3; ++k) splitDouble(v[k], hi[k], lo[k]);
     splitDouble(w, hi.w, lo.w);
-}
-
-void splitMat4(const snell::dmat4& m, mat4& hi, mat4& lo) {
-    for (int c = 0; c < 4; ++c)
-        for (int r = 0; r < 4; ++r) splitDouble(m[c][r], hi[c][r], lo[c][r]);
 }
 
 // Round a box outwards to float so it still contains the double box.
@@ -87,9 +83,8 @@ GpuScene buildGpuScene(const snell::Scene& scene, const snell::Camera& camera, P
         std::vector<snell::Aabb> bounds;
         bounds.reserve(scene.spheres.size());
         for (const snell::Sphere& s : scene.spheres) bounds.push_back(snell::sphereBounds(s));
-        const snell::Bvh bvh = snell::buildBvh(bounds);
+        const snell::Bvh bvh = snell::buildBvh(bounds, SNELL_BVH_MAX_LEAF);
         // Depth-first (pre-order) layout with skip links: stackless traversal.
-        out.nodes.reserve(bvh.nodes.size());
         std::vector<std::uint32_t> gpuIndexOf(bvh.nodes.size(), 0);
         std::vector<std::uint32_t> preorder;
         preorder.reserve(bvh.nodes.size());
@@ -110,13 +105,14 @@ GpuScene buildGpuScene(const snell::Scene& scene, const snell::Camera& camera, P
             const snell::BvhNode& n = bvh.nodes[*it];
             if (n.count == 0) subtree[*it] = 1 + subtree[n.first] + subtree[n.first + 1];
         }
+        out.nodes.reserve(preorder.size());
         for (std::uint32_t n : preorder) {
             const snell::BvhNode& b = bvh.nodes[n];
-            BvhNode node{};
+            BvhNode node;
             outwardBox(b.bounds, eye, node.lower, node.upper);
-            node.first = b.count > 0 ? b.first : 0;
-            node.count = b.count;
-            node.skip = gpuIndexOf[n] + subtree[n];
+            // Links as uint bits (shared_layout.h).
+            node.lower.w = std::bit_cast<float>(gpuIndexOf[n] + subtree[n]);
+            node.upper.w = std::bit_cast<float>(b.count > 0 ? b.first * 4 + b.count - 1 : SNELL_BVH_INNER);
             out.nodes.push_back(node);
         }
         order = bvh.order;
@@ -125,29 +121,41 @@ GpuScene buildGpuScene(const snell::Scene& scene, const snell::Camera& camera, P
     }
 
     out.spheres.reserve(scene.spheres.size());
+    out.sphereMaterials.reserve(scene.spheres.size());
     if (wide) out.sphereLows.reserve(scene.spheres.size());
     for (std::uint32_t index : order) {
         const snell::Sphere& s = scene.spheres[index];
         Sphere g{}, low{};
-        g.material = s.material;
-        g.ellipsoid = SNELL_NOT_ELLIPSOID;
         const snell::dvec3 centre = s.centre - eye;
         if (s.isTrueSphere) {
             // The anchor: the surface point nearest the origin, and its normal.
             const double distance = glm::length(centre);
             const snell::dvec3 n0 = distance > 0.0 ? -centre / distance : snell::dvec3(0.0, 0.0, 1.0);
-            splitVec4(centre + s.radius * n0, s.radius, g.anchorRadius, low.anchorRadius);
-            splitVec4(n0, 0.0, g.normal, low.normal);
+            const snell::dvec3 anchor = centre + s.radius * n0;
+            splitVec4(anchor, s.radius, g.anchorRadius, low.anchorRadius);
+            splitVec4(n0, glm::length(anchor), g.normal, low.normal);
         } else {
-            splitVec4(centre, s.radius, g.anchorRadius, low.anchorRadius);
-            g.ellipsoid = static_cast<uint>(out.ellipsoids.size());
-            Ellipsoid e, eLow;
-            splitMat4(s.objectFromWorld * worldFromCamera, e.objectFromWorld, eLow.objectFromWorld);
-            out.ellipsoids.push_back(e);
-            if (wide) out.ellipsoidLows.push_back(eLow);
+            // An ellipsoid: its index as −1 − e in w (shared_layout.h), its map's rows.
+            const double e = static_cast<double>(out.ellipsoids.size());
+            splitVec4(centre, -1.0 - e, g.anchorRadius, low.anchorRadius);
+            const snell::dmat4 objectFromOrigin = s.objectFromWorld * worldFromCamera;
+            double matrixNorm = 0.0;
+            for (int r = 0; r < 3; ++r)
+                matrixNorm = std::max(matrixNorm, std::abs(objectFromOrigin[0][r]) + std::abs(objectFromOrigin[1][r]) +
+                                                      std::abs(objectFromOrigin[2][r]));
+            splitVec4(snell::dvec3(0.0), matrixNorm, g.normal, low.normal);
+            Ellipsoid rows, rowLows;
+            vec4* hi[3] = {&rows.row0, &rows.row1, &rows.row2};
+            vec4* lo[3] = {&rowLows.row0, &rowLows.row1, &rowLows.row2};
+            for (int r = 0; r < 3; ++r)
+                splitVec4(snell::dvec3(objectFromOrigin[0][r], objectFromOrigin[1][r], objectFromOrigin[2][r]),
+                          objectFromOrigin[3][r], *hi[r], *lo[r]);
+            out.ellipsoids.push_back(rows);
+            if (wide) out.ellipsoidLows.push_back(rowLows);
         }
         if (scene.materials[s.material].refracts()) ++out.refractiveSpheres;
         out.spheres.push_back(g);
+        out.sphereMaterials.push_back(s.material);
         if (wide) out.sphereLows.push_back(low);
     }
     for (const snell::Material& m : scene.materials)
@@ -189,6 +197,14 @@ FrameParams makeFrameParams(const snell::Scene& scene, const GpuScene& gpuScene,
     f.lightCount = static_cast<uint>(gpuScene.lights.size());
     f.bvhNodeCount = static_cast<uint>(gpuScene.nodes.size());
     return f;
+}
+
+std::size_t GpuScene::bytes() const {
+    std::size_t total = 0;
+    auto add = [&](const auto& v) { total += v.size() * sizeof(v[0]); };
+    add(spheres), add(sphereMaterials), add(ellipsoids), add(materials), add(lights), add(nodes);
+    add(sphereLows), add(ellipsoidLows), add(lightLows);
+    return total;
 }
 
 }  // namespace snell::gpu

@@ -9,24 +9,27 @@
 #include <cstddef>
 #include <vector>
 
+#include "scene/Parser.h"
 #include "scene/Scene.h"
 #include "shared_layout.h"
 
 namespace snell::gpu {
 
-static_assert(sizeof(Sphere) == 48 && offsetof(Sphere, normal) == 16 && offsetof(Sphere, material) == 32 &&
-              offsetof(Sphere, ellipsoid) == 36);
-static_assert(sizeof(Ellipsoid) == 64);
+static_assert(sizeof(Sphere) == 32 && offsetof(Sphere, normal) == 16);
+static_assert(sizeof(Ellipsoid) == 48 && offsetof(Ellipsoid, row2) == 32);
 static_assert(sizeof(Material) == 48 && offsetof(Material, kt) == 32);
 static_assert(sizeof(Light) == 32 && offsetof(Light, colour) == 16);
-static_assert(sizeof(BvhNode) == 48 && offsetof(BvhNode, first) == 32 && offsetof(BvhNode, count) == 36 &&
-              offsetof(BvhNode, skip) == 40);
+static_assert(sizeof(BvhNode) == 32 && offsetof(BvhNode, upper) == 16);
+static_assert(sizeof(UnrolledSpheres) == 32 * SNELL_MAX_UNROLLED_SPHERES);
 static_assert(sizeof(FrameParams) == 144 && offsetof(FrameParams, cornerDir) == 16 &&
               offsetof(FrameParams, imageWidth) == 96 && offsetof(FrameParams, bvhNodeCount) == 120 &&
               offsetof(FrameParams, sampleCount) == 128);
-static_assert(sizeof(TileParams) == 16);
-static_assert(sizeof(PixelState) == 32 && offsetof(PixelState, started) == 16);
-static_assert(sizeof(PendingRay) == 64 && offsetof(PendingRay, depth) == 48 && offsetof(PendingRay, mediaCount) == 60);
+static_assert(sizeof(TileParams) == 32 && offsetof(TileParams, resume) == 16 && offsetof(TileParams, stepY) == 24);
+static_assert(sizeof(SlotState) == 32 && offsetof(SlotState, pixel) == 16 && offsetof(SlotState, finished) == 28);
+static_assert(sizeof(PendingRay) == 64 && offsetof(PendingRay, depth) == 48 && offsetof(PendingRay, resumeShading) == 60);
+// An ellipsoid's index rides in a float (Sphere::anchorRadius.w), exact to the
+// documented sphere limit.
+static_assert(ParseLimits::kMaxSpheres < kMaxExactIndex);
 
 // The shader's working precision for geometry (shaders/precision.glsl).
 enum class Precision { Fp32, Fp64 };
@@ -34,12 +37,13 @@ enum class Precision { Fp32, Fp64 };
 // Spheres above this count are traversed through the BVH; fewer are tested in
 // a loop. Measured by `snell bench` on lavapipe: with 10 glass spheres the BVH
 // took 2.2× the loop's time, with 72 spheres 0.86×.
-inline constexpr std::size_t kBvhThreshold = 32;
+inline constexpr std::size_t kBvhThreshold = SNELL_MAX_UNROLLED_SPHERES;
 // Whether to build and traverse a BVH: by that threshold, or forced (the bench).
 enum class BvhMode { Auto, Off, On };
 
 struct GpuScene {
     std::vector<Sphere> spheres;
+    std::vector<uint> sphereMaterials;
     std::vector<Ellipsoid> ellipsoids;
     std::vector<Material> materials;
     std::vector<Light> lights;
@@ -55,8 +59,12 @@ struct GpuScene {
     snell::dvec3 eye{0.0};       // the camera's eye
     snell::dvec3 origin{0.0};    // the world point that is the origin on the GPU
     double primaryStart = 0.0;   // distance from the eye at which primary rays start
-    int bvhDepth = 0;
+    int bvhDepth = 0;            // nodes on the longest root-to-leaf path
     double bvhBuildMs = 0.0;
+
+    bool usesBvh() const { return !nodes.empty(); }
+    // Bytes of scene data the GPU holds (low parts included).
+    std::size_t bytes() const;
 };
 
 GpuScene buildGpuScene(const snell::Scene& scene, const snell::Camera& camera,
