@@ -73,7 +73,8 @@ using uint = std::uint32_t;
 #define SNELL_SPEC_SHADOWS 10
 #define SNELL_SPEC_SPHERE_COUNT 11
 #define SNELL_SPEC_BVH_DEPTH 12
-#define SNELL_SPEC_COUNT 13
+#define SNELL_SPEC_ELLIPSOID_MASK 13
+#define SNELL_SPEC_COUNT 14
 
 // Slots of the counters buffer: rays by kind, then per-dispatch bookkeeping.
 #define SNELL_COUNTER_PRIMARY 0

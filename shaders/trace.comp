@@ -30,6 +30,9 @@ layout(constant_id = SNELL_SPEC_USE_BVH) const bool USE_BVH = false;
 // so the loops over them unroll and read each sphere at a constant offset (on
 // lavapipe ~3x faster than a counted loop); else 0.
 layout(constant_id = SNELL_SPEC_SPHERE_COUNT) const uint SPHERE_COUNT = 1u;
+// With SPHERE_COUNT: bit i set when sphere i is an ellipsoid, so each unrolled
+// test holds the code of its own kind only.
+layout(constant_id = SNELL_SPEC_ELLIPSOID_MASK) const uint ELLIPSOID_MASK = 0u;
 // With a BVH: the deepest path from the root, which bounds the traversal stack.
 layout(constant_id = SNELL_SPEC_BVH_DEPTH) const uint BVH_DEPTH = 1u;
 layout(constant_id = SNELL_SPEC_HAS_ELLIPSOIDS) const bool HAS_ELLIPSOIDS = true;
@@ -130,11 +133,14 @@ void tick(uint passes) {
 // Intersection: the maths is in intersect.glsl (shared with the test kernel);
 // here the sphere is fetched and the ray's relation to it decided.
 
+rvec4 preloadedAnchor[SNELL_MAX_UNROLLED_SPHERES];
+rvec4 preloadedNormal[SNELL_MAX_UNROLLED_SPHERES];
 real intersectSphere(uint index, rvec3 origin, real originLength, rvec3 dir, uint fromSphere, uint start) {
     uint mode = index == fromSphere ? start : ELSEWHERE;
-    rvec4 anchor = sphereAnchor(index);
-    rvec4 normal = sphereNormal(index);
-    if (HAS_ELLIPSOIDS && anchor.w < 0.0)
+    rvec4 anchor = SPHERE_COUNT > 0u ? preloadedAnchor[index] : sphereAnchor(index);
+    rvec4 normal = SPHERE_COUNT > 0u ? preloadedNormal[index] : sphereNormal(index);
+    bool ellipsoid = SPHERE_COUNT > 0u ? ((ELLIPSOID_MASK >> index) & 1u) != 0u : anchor.w < 0.0;
+    if (HAS_ELLIPSOIDS && ellipsoid)
         return intersectEllipsoid(ellipsoidMatrix(uint(-anchor.w) - 1u), normal.w, origin, originLength, dir, mode);
     return intersectTrueSphere(anchor, normal, origin, originLength, dir, mode);
 }
@@ -173,12 +179,13 @@ uint traverseBvh(rvec3 origin, real originLength, rvec3 dir, uint fromSphere, ui
     rvec3 inverseDir = safeInverse(dir);
     uint hit = NONE;
     real enter;
-    if (!hitsBox(nodeCorner(0u), nodeCorner(1u), origin, inverseDir, tHit, enter)) return NONE;
+    uvec4 rootUpper = texelFetch(bvhTexels, 1);
+    if (!hitsBox(nodeCorner(0u), rvec4(uintBitsToFloat(rootUpper)), origin, inverseDir, tHit, enter)) return NONE;
     uint node = 0u;
-    uint depth = 0u;  // entries on the stack
+    uint code = rootUpper.w;  // the node's leaf code, read with its box
+    uint depth = 0u;          // entries on the stack
     while (true) {
         tick(1u);
-        uint code = texelFetch(bvhTexels, int(2u * node + 1u)).w;
         if (code != SNELL_BVH_INNER) {
             // A leaf: spheres first · 4 + count − 1 = code.
             uint first = code >> 2;
@@ -192,24 +199,31 @@ uint traverseBvh(rvec3 origin, real originLength, rvec3 dir, uint fromSphere, ui
             }
             if ((anyHit && hit != NONE) || depth == 0u) break;
             node = bvhStack[--depth];
+            code = texelFetch(bvhTexels, int(2u * node + 1u)).w;
             continue;
         }
         uint near = node + 1u;
         uvec4 nearLower = texelFetch(bvhTexels, int(2u * near));
+        uvec4 nearUpper = texelFetch(bvhTexels, int(2u * near + 1u));
         uint far = nearLower.w;
+        uvec4 farUpper = texelFetch(bvhTexels, int(2u * far + 1u));
         real enterNear, enterFar;
-        bool hitsNear = hitsBox(rvec4(uintBitsToFloat(nearLower)), nodeCorner(2u * near + 1u), origin, inverseDir,
-                                tHit, enterNear);
-        bool hitsFar = hitsBox(nodeCorner(2u * far), nodeCorner(2u * far + 1u), origin, inverseDir, tHit, enterFar);
+        bool hitsNear = hitsBox(rvec4(uintBitsToFloat(nearLower)), rvec4(uintBitsToFloat(nearUpper)), origin,
+                                inverseDir, tHit, enterNear);
+        bool hitsFar = hitsBox(nodeCorner(2u * far), rvec4(uintBitsToFloat(farUpper)), origin, inverseDir, tHit,
+                               enterFar);
         if (hitsNear && hitsFar) {
-            if (enterFar < enterNear) { uint n = near; near = far; far = n; }
-            bvhStack[depth++] = far;
-            node = near;
+            bool farFirst = enterFar < enterNear;
+            bvhStack[depth++] = farFirst ? near : far;
+            node = farFirst ? far : near;
+            code = farFirst ? farUpper.w : nearUpper.w;
         } else if (hitsNear || hitsFar) {
             node = hitsNear ? near : far;
+            code = hitsNear ? nearUpper.w : farUpper.w;
         } else {
             if (depth == 0u) break;
             node = bvhStack[--depth];
+            code = texelFetch(bvhTexels, int(2u * node + 1u)).w;
         }
     }
     return hit;
@@ -293,7 +307,9 @@ uint mediumAt(uint k) {
 // Where a ray met its closest surface, and what shading needs there.
 struct Hit {
     uint sphere;
-    uint material;
+    vec4 kd;          // the material, fetched once (shared_layout.h: Material)
+    vec4 ks;
+    vec4 kt;
     rvec3 point;
     rvec3 normal;     // the shading normal N (against the ray)
     bool fromOutside; // the ray arrived from outside the sphere
@@ -340,7 +356,10 @@ bool findHit(Ray r, vec3 weight, inout vec3 sum, out Hit h) {
         sum += weight * frame.background.rgb;
         return false;
     }
-    h.material = sphereMaterial(h.sphere);
+    uint material = sphereMaterial(h.sphere);
+    h.kd = materialKd(material);
+    h.ks = materialKs(material);
+    h.kt = HAS_REFRACTION ? materialKt(material) : vec4(0.0);
     // The hit point o + t d, not re-projected onto the surface: re-projecting
     // (centre + r n̂, or normalising the object-space point) rounds at the
     // scale of the centre or of the largest semi-axis, which for a big floor
@@ -374,9 +393,8 @@ vec3 shadeLight(uint j, Hit h, rvec3 v) {
     // A shadow ray towards N's side enters the hit sphere only when N = −No.
     if (SHADOWS && occluded(h.point, l, distance, h.sphere, h.fromOutside ? LEAVING : ENTERING)) return vec3(0.0);
     float rv = float(dot(2.0 * dot(h.normal, l) * h.normal - l, v));
-    vec4 kd = materialKd(h.material);
-    float specular = rv > 0.0 ? pow(rv, kd.w) : 0.0;
-    return lightColour(j) * (kd.rgb * nl + materialKs(h.material).rgb * specular);
+    float specular = rv > 0.0 ? pow(rv, h.kd.w) : 0.0;
+    return lightColour(j) * (h.kd.rgb * nl + h.ks.rgb * specular);
 }
 
 // 4–5. The children of ray r at hit h: reflection (keeps the medium stack) and
@@ -388,12 +406,12 @@ void spawnChildren(uint slot, inout uint pending, inout Ray r, vec3 weight, Hit 
     if (r.depth >= frame.maxDepth) return;
     rvec3 d = r.dir;
     rvec3 n = h.normal;
-    vec3 reflectedWeight = HAS_REFLECTION ? weight * materialKs(h.material).rgb : vec3(0.0);
+    vec3 reflectedWeight = HAS_REFLECTION ? weight * h.ks.rgb : vec3(0.0);
     bool refracts = false;
     rvec3 refracted = rvec3(0.0);
     vec3 transmittedWeight = vec3(0.0);
     uint removeAt = r.mediaCount;  // leaving: where this sphere is in the stack
-    vec4 kt = HAS_REFRACTION ? materialKt(h.material) : vec4(0.0);
+    vec4 kt = h.kt;
     if (HAS_REFRACTION && max(kt.r, max(kt.g, kt.b)) > 0.0) {
         transmittedWeight = weight * kt.rgb;
         real etaI, etaT;
@@ -479,6 +497,10 @@ void main() {
     uint slots = gl_NumWorkGroups.x * uint(SNELL_WORKGROUP_SIZE);
     uint tilePixels = tile.width * tile.height;
     [[unroll]] for (int k = 0; k < SNELL_RAY_COUNTER_COUNT; ++k) countedRays[k] = 0u;
+    [[unroll]] for (uint i = 0u; i < SPHERE_COUNT; ++i) {
+        preloadedAnchor[i] = sphereAnchor(i);
+        preloadedNormal[i] = sphereNormal(i);
+    }
 
     // This invocation's progress: its current pixel, that pixel's sum, and the
     // rays on its stack. Fresh, or resumed from the last dispatch.
@@ -542,7 +564,7 @@ void main() {
                 vec3 sum = state.sum.rgb;
                 shading = findHit(ray, weight, sum, h);
                 // The ambient part once, not again when shading resumes.
-                if (shading && ray.resumeShading == 0u) sum += weight * frame.ambient.rgb * materialKd(h.material).rgb;
+                if (shading && ray.resumeShading == 0u) sum += weight * frame.ambient.rgb * h.kd.rgb;
                 state.sum.rgb = sum;
             }
             hasRay = shading;

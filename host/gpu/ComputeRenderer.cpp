@@ -145,6 +145,9 @@ ComputeRenderer::Specialisation ComputeRenderer::specialise(const RenderRequest&
     values[SNELL_SPEC_USE_BVH] = layout_.usesBvh();
     const bool unrolled = !layout_.usesBvh() && layout_.spheres.size() <= SNELL_MAX_UNROLLED_SPHERES;
     values[SNELL_SPEC_SPHERE_COUNT] = unrolled ? static_cast<std::uint32_t>(layout_.spheres.size()) : 0u;
+    if (unrolled)
+        for (std::size_t i = 0; i < layout_.spheres.size(); ++i)
+            if (layout_.spheres[i].anchorRadius.w < 0.0f) values[SNELL_SPEC_ELLIPSOID_MASK] |= 1u << i;
     values[SNELL_SPEC_BVH_DEPTH] = static_cast<std::uint32_t>(std::max(1, layout_.bvhDepth));
     values[SNELL_SPEC_HAS_ELLIPSOIDS] = !layout_.ellipsoids.empty();
     values[SNELL_SPEC_HAS_REFRACTION] = hasRefraction;

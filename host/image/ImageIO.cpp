@@ -117,6 +117,10 @@ public:
             png_init_io(png_, file_);
             png_set_IHDR(png_, info_, std::uint32_t(width), std::uint32_t(height), 8, PNG_COLOR_TYPE_RGB,
                          PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
+            // Fast over small: zlib level 1 and no row filter write a 512² render
+            // in ~6 ms instead of ~30 (the files are ~25 % larger).
+            png_set_compression_level(png_, 1);
+            png_set_filter(png_, 0, PNG_FILTER_NONE);
             if (!chunks.empty()) png_set_text(png_, info_, chunks.data(), int(chunks.size()));
             png_write_info(png_, info_);
         });
