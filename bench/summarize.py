@@ -1,26 +1,31 @@
 #!/usr/bin/env python3
-"""Markdown tables from `snell bench`'s bench.json, as the README shows them:
-python3 bench/summarize.py bench/results/bench.json"""
+"""Tables and a plot from `snell bench`'s bench.json.
+
+    python3 bench/summarize.py bench/results/bench.json [--plot bench/results/bench.png]
+
+prints the Markdown tables of docs/performance.md and, with --plot, draws
+speed against error: a panel per scene, dispatch time (ms) against the mean
+error (in 1/255) of each setting, each point named, the default ringed and the
+Pareto front drawn (matplotlib, Debian's python3-matplotlib)."""
+import argparse
 import json
-import sys
+import math
 
 
 def ms(v):
     return "–" if v is None else (f"{v:.0f}" if v >= 100 else f"{v:.1f}" if v >= 10 else f"{v:.2f}")
 
 
-def main() -> None:
-    if len(sys.argv) != 2:
-        sys.exit(__doc__)
-    d = json.load(open(sys.argv[1]))
+def tables(d):
     results = [r for r in d["results"] if not r["failure"]]
     by = {}
     for r in results:
         by.setdefault(r["scene"], {})[r["setting"]] = r
     print(f"Device: {d['device']}; {d['size']}×{d['size']}, median of {d['runs']} runs ({d['timing']}).\n")
 
-    print("| scene | spheres | default ms | Mrays/s | mean error | max | best setting within 0.5/255 | its ms | fp64 ms | fp64 error |")
-    print("|---|---|---|---|---|---|---|---|---|---|")
+    print("| scene | spheres | default ms | Mrays/s | mean error | max | CPU reference ms, same settings | "
+          "GPU faster | best setting within 0.5/255 | its ms | fp64 ms | fp64 error |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
     for scene, settings in by.items():
         de = settings.get("default")
         if not de:
@@ -29,12 +34,14 @@ def main() -> None:
         good = [r for r in settings.values() if r["error"]["mean_abs_error"] <= 0.5]
         best = min(good, key=lambda r: r["dispatch_ms"]["median"]) if good else None
         f = settings.get("fp64")
-        print(f"| {scene} | {de['spheres']} | {ms(de['dispatch_ms']['median'])} | "
-              f"{rays / de['dispatch_ms']['median'] / 1e3:.1f} | {de['error']['mean_abs_error']:.3f} | "
-              f"{de['error']['max_error']} | {best['setting'] if best else '–'} | "
-              f"{ms(best['dispatch_ms']['median']) if best else '–'} | "
+        cpu = de.get("cpu_default_ms")
+        gpu = de["dispatch_ms"]["median"]
+        faster = "–" if cpu is None else f"{cpu / gpu:.1f}×"
+        print(f"| {scene} | {de['spheres']} | {ms(gpu)} | {rays / gpu / 1e3:.1f} | "
+              f"{de['error']['mean_abs_error']:.3f} | {de['error']['max_error']} | {ms(cpu)} | {faster} | "
+              f"{best['setting'] if best else '–'} | {ms(best['dispatch_ms']['median']) if best else '–'} | "
               f"{ms(f['dispatch_ms']['median']) if f else '–'} | "
-              f"{f['error']['mean_abs_error']:.3f} |" if f else "–")
+              f"{(format(f['error']['mean_abs_error'], '.3f')) if f else '–'} |")
 
     print("\n| hard case | fp32 mean | fp32 max | fp32 bad % | fp32 ms | fp64 mean | fp64 max | fp64 bad % | fp64 ms |")
     print("|---|---|---|---|---|---|---|---|---|")
@@ -48,7 +55,8 @@ def main() -> None:
               f"{100 * b['error']['bad_fraction']:.3f} | {ms(b['dispatch_ms']['median'])} |")
 
     if d["peers"]:
-        print("\n| bench scene | size | snell dispatch ms | snell command ms | first image cold / warm ms | CPU reference ms | POV-Ray trace ms | POV-Ray command ms | trace ratio | command ratio |")
+        print("\n| bench scene | size | snell dispatch ms | snell command ms | first image cold / warm ms | "
+              "CPU reference ms | POV-Ray trace ms | POV-Ray command ms | trace ratio | command ratio |")
         print("|---|---|---|---|---|---|---|---|---|---|")
         for p in d["peers"]:
             pt, pc = p["povray_trace_ms"], p["povray_command_ms"]
@@ -56,8 +64,7 @@ def main() -> None:
             command_ratio = "–" if pc is None else f"{pc / p['snell_command_ms']:.2f}×"
             print(f"| {p['scene']} | {p['size']}² | {ms(p['snell_dispatch_ms'])} | {ms(p['snell_command_ms'])} | "
                   f"{ms(p['first_image_cold_ms'])} / {ms(p['first_image_warm_ms'])} | {ms(p['cpu_reference_ms'])} | "
-                  f"{ms(pt)} | {ms(pc)} | "
-                  f"{trace_ratio} | {command_ratio} |")
+                  f"{ms(pt)} | {ms(pc)} | {trace_ratio} | {command_ratio} |")
 
     if d["scaling"]:
         print("\n| spheres | parse ms | BVH build ms | render ms (median, min–max) | scene on the GPU MiB | peak RSS MiB |")
@@ -70,6 +77,79 @@ def main() -> None:
     c = d["ceiling_tests_per_s"]
     print(f"\nCeiling (micro-kernel, one ray against 64 spheres): {c['centre_radius'] / 1e9:.2f} G tests/s "
           f"centre+radius, {c['inverse_matrix'] / 1e9:.2f} G inverse matrix.")
+    f = d.get("floor")
+    if f:
+        print(f"Floor at {f['size']}²: a kernel that only stores each pixel {ms(f['store_kernel_ms'])} ms; "
+              f"the renderer on an empty scene {ms(f['empty_scene_ms'])} ms "
+              f"({f['empty_scene_ms'] / f['store_kernel_ms']:.1f}×).")
+
+
+def pareto(points):
+    """The points no faster point is as accurate as, fastest first."""
+    front, best = [], math.inf
+    for p in sorted(points, key=lambda p: p[0]):
+        if p[1] < best:
+            front.append(p)
+            best = p[1]
+    return front
+
+
+def plot(d, path):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.ticker import FuncFormatter, LogFormatterSciNotation, LogLocator, NullFormatter
+
+    results = [r for r in d["results"] if not r["failure"]]
+    scenes = []
+    for r in results:
+        if r["scene"] not in scenes:
+            scenes.append(r["scene"])
+    floor = 1e-3  # an exact result still needs a place on a log axis
+    columns = 4
+    rows = math.ceil(len(scenes) / columns)
+    fig, axes = plt.subplots(rows, columns, figsize=(4.2 * columns, 3.4 * rows), squeeze=False)
+    for ax in axes.flat[len(scenes):]:
+        ax.set_visible(False)
+    for ax, scene in zip(axes.flat, scenes):
+        points = [(r["dispatch_ms"]["median"], max(r["error"]["mean_abs_error"], floor), r["setting"])
+                  for r in results if r["scene"] == scene]
+        front = pareto(points)
+        ax.plot([p[0] for p in front], [p[1] for p in front], color="tab:red", lw=1, zorder=1, label="Pareto front")
+        for t, e, name in points:
+            default = name == "default"
+            ax.scatter([t], [e], s=60 if default else 14, zorder=2,
+                       facecolors="none" if default else "tab:blue", edgecolors="tab:blue",
+                       linewidths=1.5 if default else 0.5)
+            ax.annotate(name, (t, e), fontsize=6, xytext=(3, 2), textcoords="offset points")
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.xaxis.set_major_locator(LogLocator(base=10, subs=(1, 2, 5)))
+        ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+        ax.xaxis.set_minor_formatter(NullFormatter())
+        ax.yaxis.set_major_formatter(LogFormatterSciNotation())
+        ax.yaxis.set_minor_formatter(NullFormatter())
+        ax.set_title(scene, fontsize=9)
+        ax.set_xlabel("dispatch time (ms)", fontsize=8)
+        ax.set_ylabel("mean error (1/255)", fontsize=8)
+        ax.tick_params(labelsize=7)
+        ax.grid(True, which="major", lw=0.3, alpha=0.5)
+    fig.suptitle(f"snell bench: time against error, {d['size']}² — {d['device']}\n"
+                 f"ringed: the default settings; red: the Pareto front; errors below {floor} drawn at {floor}",
+                 fontsize=11)
+    fig.tight_layout(rect=(0, 0, 1, 0.96))
+    fig.savefig(path, dpi=90)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("json", help="bench.json written by snell bench")
+    parser.add_argument("--plot", metavar="PNG", help="also draw time against error into this PNG")
+    args = parser.parse_args()
+    d = json.load(open(args.json))
+    tables(d)
+    if args.plot:
+        plot(d, args.plot)
 
 
 if __name__ == "__main__":

@@ -9,7 +9,7 @@
 #include "kernel_layout.h"
 
 layout(local_size_x = SNELL_KERNEL_GROUP_SIZE) in;
-layout(set = 0, binding = 0, std430) readonly buffer SphereBlock { CeilingSphere spheres[]; };
+layout(set = 0, binding = 0, std430) readonly buffer CeilingSphereBlock { CeilingSphere spheres[]; };
 layout(set = 0, binding = 1, std430) writeonly buffer ResultBlock { float nearest[]; };
 
 void main() {

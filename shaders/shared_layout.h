@@ -44,9 +44,9 @@ using uint = std::uint32_t;
 #define SNELL_BINDING_MATERIALS 9         // Material
 #define SNELL_BINDING_LIGHTS 10           // Light
 #define SNELL_BINDING_BVH 11              // RGBA32UI: BvhNode
-// Uniform buffer: the spheres of a scene small enough to skip the BVH
-// (UnrolledSpheres; for fp64 followed by their low parts), read at constant
-// offsets by the unrolled loops of trace.comp.
+// Uniform buffer: the spheres of a scene small enough to need no BVH
+// (SphereBlock; for fp64 followed by their low parts), which the shader's
+// loops read at one index for the whole SIMD row (a scalar load).
 #define SNELL_BINDING_SPHERE_BLOCK 12
 #define SNELL_BINDING_COUNT_FP32 13
 // The fp64 shader (--precision fp64) reads scene values as float pairs hi + lo
@@ -74,7 +74,8 @@ using uint = std::uint32_t;
 #define SNELL_SPEC_SPHERE_COUNT 11
 #define SNELL_SPEC_BVH_DEPTH 12
 #define SNELL_SPEC_ELLIPSOID_MASK 13
-#define SNELL_SPEC_COUNT 14
+#define SNELL_SPEC_SPHERES_IN_BLOCK 14
+#define SNELL_SPEC_COUNT 15
 
 // Slots of the counters buffer: rays by kind, then per-dispatch bookkeeping.
 #define SNELL_COUNTER_PRIMARY 0
@@ -113,11 +114,14 @@ struct Sphere {
     vec4 normal;        // xyz: n0 (unit), w: |P0| (or the ellipsoid's matrix norm)
 };
 
-// Scenes of at most this many spheres are intersected without a BVH, by
-// unrolled loops over a uniform buffer (host/gpu/GpuScene.h: kBvhThreshold).
+// Scenes of at most SNELL_BLOCK_SPHERES spheres can be intersected without a
+// BVH, from a uniform block (8 KiB; with its low parts 16 KiB, the least
+// maxUniformBufferRange a Vulkan device has); up to SNELL_MAX_UNROLLED_SPHERES
+// the loops over them are unrolled (host/gpu/GpuScene.h: kBvhThreshold).
+#define SNELL_BLOCK_SPHERES 256
 #define SNELL_MAX_UNROLLED_SPHERES 32
-struct UnrolledSpheres {
-    Sphere spheres[SNELL_MAX_UNROLLED_SPHERES];
+struct SphereBlock {
+    Sphere spheres[SNELL_BLOCK_SPHERES];
 };
 
 // An ellipsoid is the unit sphere seen through objectFromWorld (camera-relative

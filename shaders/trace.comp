@@ -33,6 +33,8 @@ layout(constant_id = SNELL_SPEC_SPHERE_COUNT) const uint SPHERE_COUNT = 1u;
 // With SPHERE_COUNT: bit i set when sphere i is an ellipsoid, so each unrolled
 // test holds the code of its own kind only.
 layout(constant_id = SNELL_SPEC_ELLIPSOID_MASK) const uint ELLIPSOID_MASK = 0u;
+// Every sphere is in the uniform block (SNELL_BLOCK_SPHERES at most).
+layout(constant_id = SNELL_SPEC_SPHERES_IN_BLOCK) const bool SPHERES_IN_BLOCK = false;
 // With a BVH: the deepest path from the root, which bounds the traversal stack.
 layout(constant_id = SNELL_SPEC_BVH_DEPTH) const uint BVH_DEPTH = 1u;
 layout(constant_id = SNELL_SPEC_HAS_ELLIPSOIDS) const bool HAS_ELLIPSOIDS = true;
@@ -67,11 +69,11 @@ layout(set = 0, binding = SNELL_BINDING_LIGHTS) uniform textureBuffer lightTexel
 layout(set = 0, binding = SNELL_BINDING_BVH) uniform utextureBuffer bvhTexels;
 #ifdef SNELL_FP64
 layout(set = 0, binding = SNELL_BINDING_SPHERE_BLOCK, std140) uniform SphereUniforms {
-    UnrolledSpheres small;
-    UnrolledSpheres smallLow;  // one block: a second uniform buffer crashes Mesa 22's llvmpipe here
+    SphereBlock small;
+    SphereBlock smallLow;  // one block: a second uniform buffer crashes Mesa 22's llvmpipe here
 };
 #else
-layout(set = 0, binding = SNELL_BINDING_SPHERE_BLOCK, std140) uniform SphereUniforms { UnrolledSpheres small; };
+layout(set = 0, binding = SNELL_BINDING_SPHERE_BLOCK, std140) uniform SphereUniforms { SphereBlock small; };
 #endif
 
 // Scene values as the shader computes with them. In fp64 a value is its float
@@ -89,14 +91,15 @@ layout(set = 0, binding = SNELL_BINDING_RAY_STACK_LOW, std430) buffer RayStackLo
 #define WIDE(hi, lo) (hi)
 #define FETCH(texels, i) texelFetch(texels, int(i))
 #endif
-// A small scene's spheres come from a uniform buffer: the unrolled loops read
-// them at constant offsets, cheaper than texel fetches on lavapipe.
+// A small scene's spheres come from a uniform buffer: loops over them read one
+// sphere for the whole SIMD row, a scalar load, cheaper on lavapipe than a
+// texel fetch (which serves eight lanes of any indices).
 rvec4 sphereAnchor(uint i) {
-    if (SPHERE_COUNT > 0u) return WIDE(small.spheres[i].anchorRadius, smallLow.spheres[i].anchorRadius);
+    if (SPHERES_IN_BLOCK) return WIDE(small.spheres[i].anchorRadius, smallLow.spheres[i].anchorRadius);
     return FETCH(sphereTexels, 2u * i);
 }
 rvec4 sphereNormal(uint i) {
-    if (SPHERE_COUNT > 0u) return WIDE(small.spheres[i].normal, smallLow.spheres[i].normal);
+    if (SPHERES_IN_BLOCK) return WIDE(small.spheres[i].normal, smallLow.spheres[i].normal);
     return FETCH(sphereTexels, 2u * i + 1u);
 }
 rmat4 ellipsoidMatrix(uint e) {
@@ -242,7 +245,7 @@ uint closestHit(rvec3 origin, rvec3 dir, uint fromSphere, uint start, out real t
         }
         return hit;
     }
-    for (uint i = 0u; i < frame.sphereCount; ++i) {  // no BVH, by request (the benchmark)
+    for (uint i = 0u; i < frame.sphereCount; ++i) {
         tick(1u);
         real t = intersectSphere(i, origin, originLength, dir, fromSphere, start);
         if (t < tHit) { tHit = t; hit = i; }

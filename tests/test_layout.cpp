@@ -20,7 +20,7 @@ TEST(Layout, Sphere) {
     EXPECT_EQ(sizeof(gpu::Sphere), 32u);
     EXPECT_EQ(offsetof(gpu::Sphere, anchorRadius), 0u);
     EXPECT_EQ(offsetof(gpu::Sphere, normal), 16u);
-    EXPECT_EQ(sizeof(gpu::UnrolledSpheres), 32u * SNELL_MAX_UNROLLED_SPHERES);
+    EXPECT_EQ(sizeof(gpu::SphereBlock), 32u * SNELL_BLOCK_SPHERES);
 }
 
 // An ellipsoid's sphere carries −1 − its index in anchorRadius.w.

@@ -23,6 +23,7 @@
 #include "metrics/ImageMetrics.h"
 #include "ray_sphere_kernel_comp_spv.h"
 #include "ray_sphere_kernel_matrix_comp_spv.h"
+#include "store_kernel_comp_spv.h"
 #include "reference/CpuRenderer.h"
 #include "scene/Parser.h"
 #include "scene/Transform.h"
@@ -128,9 +129,13 @@ std::string quote(const std::string& s) {
     return out + "'";
 }
 
-// The device's ceiling: ray–sphere tests per second of the micro-kernel.
+// The device's ceiling: ray–sphere tests per second of the micro-kernel; and
+// its floor: a dispatch that only stores a pixel per invocation, against the
+// renderer on a scene with nothing in it, at the same size.
 struct Ceiling {
     double centreRadius = 0.0, matrix = 0.0;  // tests per second
+    int floorSize = 0;                         // pixels a side
+    double storeMs = 0.0, emptySceneMs = 0.0;  // median dispatch times
 };
 
 Ceiling measureCeiling(vk::Context& context, int runs, bool quick) {
@@ -167,6 +172,31 @@ Ceiling measureCeiling(vk::Context& context, int runs, bool quick) {
     }
     context.destroy(input);
     context.destroy(output);
+
+    // The floor.
+    c.floorSize = quick ? 256 : 1024;
+    const std::uint32_t pixels = std::uint32_t(c.floorSize) * std::uint32_t(c.floorSize);
+    vk::Buffer image = context.createBuffer(VkDeviceSize(pixels) * 16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, false);
+    try {
+        vk::ComputeKernel kernel(context, snell_store_kernel_comp_spv, sizeof snell_store_kernel_comp_spv, 1);
+        kernel.run({&image}, nullptr, pixels / SNELL_KERNEL_GROUP_SIZE);
+        std::vector<double> ms;
+        for (int r = 0; r < runs; ++r) ms.push_back(kernel.run({&image}, nullptr, pixels / SNELL_KERNEL_GROUP_SIZE));
+        c.storeMs = stats(ms).median;
+    } catch (...) {
+        context.destroy(image);
+        throw;
+    }
+    context.destroy(image);
+    const Scene empty = parseScene("view " + std::to_string(c.floorSize) + " 0.5\nbackground 0.2 0.3 0.4\n", "empty.scn");
+    RenderRequest request;
+    request.width = request.height = c.floorSize;
+    request.camera = Camera::fromSpec(c.floorSize, empty.halfWidth);
+    ComputeRenderer renderer(context, empty, request.camera);
+    renderer.render(request, false);
+    std::vector<double> ms;
+    for (int r = 0; r < runs; ++r) ms.push_back(renderer.render(request, false).renderMs);
+    c.emptySceneMs = stats(ms).median;
     return c;
 }
 
@@ -245,73 +275,6 @@ std::vector<SceneFile> collectScenes(const BenchOptions& o) {
     return out;
 }
 
-void writeSvg(const std::string& path, const std::vector<Result>& results, const std::string& device) {
-    std::map<std::string, std::vector<const Result*>> byScene;
-    std::vector<std::string> order;
-    for (const Result& r : results) {
-        if (!r.failure.empty()) continue;
-        if (!byScene.count(r.scene)) order.push_back(r.scene);
-        byScene[r.scene].push_back(&r);
-    }
-    const int columns = 4, panelW = 300, panelH = 220, margin = 46;
-    const int rows = (int(order.size()) + columns - 1) / columns;
-    std::ofstream svg(path);
-    svg << "<svg xmlns='http://www.w3.org/2000/svg' width='" << columns * panelW << "' height='" << rows * panelH + 40
-        << "' font-family='sans-serif' font-size='10'>\n<rect width='100%' height='100%' fill='white'/>\n"
-        << "<text x='10' y='20' font-size='14'>snell bench: dispatch time (ms, log) against mean error (1/255, log)"
-        << " on " << device << "; red: the Pareto front, ringed: the default settings</text>\n";
-    for (std::size_t i = 0; i < order.size(); ++i) {
-        const auto& points = byScene[order[i]];
-        const int ox = int(i % columns) * panelW, oy = 40 + int(i / columns) * panelH;
-        double t0 = 1e300, t1 = 0, e0 = 1e300, e1 = 0;
-        auto err = [](const Result* r) { return std::max(r->error.meanAbsError, 1e-4); };
-        for (const Result* r : points) {
-            t0 = std::min(t0, r->dispatchMs.median);
-            t1 = std::max(t1, r->dispatchMs.median);
-            e0 = std::min(e0, err(r));
-            e1 = std::max(e1, err(r));
-        }
-        t0 = std::log10(std::max(t0, 1e-3)) - 0.1;
-        t1 = std::log10(std::max(t1, 1e-3)) + 0.1;
-        e0 = std::log10(e0) - 0.2;
-        e1 = std::log10(e1) + 0.2;
-        const double w = panelW - margin - 10, h = panelH - margin - 20;
-        auto px = [&](double t) { return ox + margin + (std::log10(std::max(t, 1e-3)) - t0) / (t1 - t0) * w; };
-        auto py = [&](double e) { return oy + 20 + h - (std::log10(e) - e0) / (e1 - e0) * h; };
-        svg << "<g><rect x='" << ox + margin << "' y='" << oy + 20 << "' width='" << w << "' height='" << h
-            << "' fill='none' stroke='#999'/>\n<text x='" << ox + margin << "' y='" << oy + 14 << "'>"
-            << order[i] << "</text>\n";
-        svg << "<text x='" << ox + margin << "' y='" << oy + 20 + h + 14 << "'>" << number(std::pow(10, t0))
-            << " ms</text><text x='" << ox + margin + w - 50 << "' y='" << oy + 20 + h + 14 << "'>"
-            << number(std::pow(10, t1)) << " ms</text>\n";
-        svg << "<text x='" << ox + 2 << "' y='" << oy + 28 << "'>" << number(std::pow(10, e1)) << "</text><text x='"
-            << ox + 2 << "' y='" << oy + 20 + h << "'>" << number(std::pow(10, e0)) << "</text>\n";
-        // Pareto front: faster points first; a point is on it when no faster one is as accurate.
-        std::vector<const Result*> sorted = points;
-        std::sort(sorted.begin(), sorted.end(), [](const Result* a, const Result* b) {
-            return a->dispatchMs.median < b->dispatchMs.median;
-        });
-        std::string front;
-        double best = 1e300;
-        for (const Result* r : sorted) {
-            if (err(r) < best) {
-                best = err(r);
-                front += number(px(r->dispatchMs.median)) + "," + number(py(err(r))) + " ";
-            }
-        }
-        svg << "<polyline points='" << front << "' fill='none' stroke='red'/>\n";
-        for (const Result* r : points) {
-            svg << "<circle cx='" << px(r->dispatchMs.median) << "' cy='" << py(err(r)) << "' r='"
-                << (r->setting.name == "default" ? 5 : 3) << "' fill='"
-                << (r->setting.name == "default" ? "none" : "#236") << "' stroke='#236'><title>" << r->setting.name
-                << ": " << number(r->dispatchMs.median) << " ms, error " << number(r->error.meanAbsError)
-                << "</title></circle>\n";
-        }
-        svg << "</g>\n";
-    }
-    svg << "</svg>\n";
-}
-
 }  // namespace
 
 void runBench(const BenchOptions& o, std::ostream& log) {
@@ -332,12 +295,14 @@ void runBench(const BenchOptions& o, std::ostream& log) {
     const auto ceilingStart = Clock::now();
     const Ceiling ceiling = measureCeiling(context, runs, o.quick);
     log << "ceiling: " << ceiling.centreRadius * 1e-9 << " G ray-sphere tests/s (centre+radius), "
-        << ceiling.matrix * 1e-9 << " G (inverse matrix), " << msSince(ceilingStart) / 1000 << " s\n";
+        << ceiling.matrix * 1e-9 << " G (inverse matrix); floor at " << ceiling.floorSize << "²: store-only kernel "
+        << number(ceiling.storeMs) << " ms, empty scene " << number(ceiling.emptySceneMs) << " ms; "
+        << msSince(ceilingStart) / 1000 << " s\n";
 
     auto cancelled = [&] { return o.cancel && o.cancel->load(); };
     std::vector<Result> results;
     std::vector<Peer> peers;
-    std::map<std::string, double> referenceMs;
+    std::map<std::string, double> referenceMs, cpuDefaultMs;
     for (const SceneFile& file : files) {
         if (cancelled()) throw BenchError("cancelled");
         const Scene scene = parseSceneFile(file.path);
@@ -357,6 +322,12 @@ void runBench(const BenchOptions& o, std::ostream& log) {
         const auto cpuStart = Clock::now();
         const Image exact = cpu.render(exactRequest);
         referenceMs[name] = msSince(cpuStart);
+        // The CPU reference again, at the GPU's default settings: a peer at equal work.
+        RenderRequest sameRequest = base;
+        sameRequest.trace = kDefaultSettings;
+        const auto sameStart = Clock::now();
+        cpu.render(sameRequest);
+        cpuDefaultMs[name] = msSince(sameStart);
 
         std::map<std::pair<int, int>, std::unique_ptr<ComputeRenderer>> renderers;
         const std::vector<Setting> settings = settingsFor(scene, o.quick);
@@ -398,7 +369,8 @@ void runBench(const BenchOptions& o, std::ostream& log) {
         }
         const Result& def = results[results.size() - settings.size()];
         log << name << ": default " << number(def.dispatchMs.median) << " ms, error "
-            << number(def.error.meanAbsError) << "/255; reference " << number(referenceMs[name]) << " ms\n";
+            << number(def.error.meanAbsError) << "/255; CPU reference " << number(referenceMs[name])
+            << " ms converged, " << number(cpuDefaultMs[name]) << " ms at the default settings\n";
 
         // Peers on the shared bench scenes: depth 5, no cut-off, at the scene's own size.
         if (file.group != "bench") continue;
@@ -539,10 +511,13 @@ void runBench(const BenchOptions& o, std::ostream& log) {
     // JSON: everything, for tools.
     {
         std::ofstream json(fs::path(o.outDir) / "bench.json");
-        json << "{\n  \"device\": " << jsonString(device) << ",\n  \"size\": " << size << ",\n  \"runs\": " << runs
+        json << "{\n  \"device\": " << jsonString(device) << ",\n  \"driver\": " << jsonString(context.driverInfo())
+             << ",\n  \"size\": " << size << ",\n  \"runs\": " << runs
              << ",\n  \"timing\": \"" << (context.timestampsSupported() ? "gpu-timestamps" : "host") << "\""
              << ",\n  \"ceiling_tests_per_s\": {\"centre_radius\": " << number(ceiling.centreRadius)
-             << ", \"inverse_matrix\": " << number(ceiling.matrix) << "},\n  \"results\": [\n";
+             << ", \"inverse_matrix\": " << number(ceiling.matrix) << "},\n  \"floor\": {\"size\": "
+             << ceiling.floorSize << ", \"store_kernel_ms\": " << number(ceiling.storeMs)
+             << ", \"empty_scene_ms\": " << number(ceiling.emptySceneMs) << "},\n  \"results\": [\n";
         for (std::size_t i = 0; i < results.size(); ++i) {
             const Result& r = results[i];
             json << "    {\"scene\": " << jsonString(r.scene) << ", \"setting\": " << jsonString(r.setting.name)
@@ -554,6 +529,7 @@ void runBench(const BenchOptions& o, std::ostream& log) {
                  << "}, \"rays\": {\"primary\": " << r.rays.primary << ", \"shadow\": " << r.rays.shadow
                  << ", \"reflected\": " << r.rays.reflected << ", \"refracted\": " << r.rays.refracted
                  << "}, \"error\": " << r.error.json() << ", \"reference_ms\": " << number(referenceMs[r.scene])
+                 << ", \"cpu_default_ms\": " << number(cpuDefaultMs[r.scene])
                  << ", \"failure\": " << jsonString(r.failure) << "}" << (i + 1 < results.size() ? "," : "") << "\n";
         }
         json << "  ],\n  \"peers\": [\n";
@@ -581,8 +557,8 @@ void runBench(const BenchOptions& o, std::ostream& log) {
         }
         json << "  ]\n}\n";
     }
-    writeSvg((fs::path(o.outDir) / "bench.svg").string(), results, device);
-    log << "bench: wrote " << (fs::path(o.outDir) / "bench.csv").string() << ", bench.json, bench.svg\n";
+    log << "bench: wrote " << (fs::path(o.outDir) / "bench.csv").string()
+        << " and bench.json; bench/summarize.py makes the tables and the plot\n";
 }
 
 }  // namespace snell

@@ -2,9 +2,11 @@
 // renderer's settings (depth, weight cut-off, precision, BVH, supersampling),
 // times the dispatches by GPU timestamps (median and range of several runs
 // after a warm-up), measures the error against the converged CPU reference,
-// and records the peers of the same run: the CPU reference itself, POV-Ray
-// 3.7 on the shared bench scenes, the device's ray–sphere ceiling, and the
-// render time against sphere count. Writes bench.csv, bench.json, bench.svg.
+// and records the peers of the same run: the CPU reference itself (converged,
+// and at the GPU's default settings), POV-Ray 3.7 on the shared bench scenes,
+// the device's ray–sphere ceiling and store-only floor, and the render time
+// against sphere count. Writes bench.csv and bench.json; bench/summarize.py
+// turns them into tables and a plot.
 #pragma once
 
 #include <atomic>
@@ -18,7 +20,7 @@ namespace snell {
 struct BenchOptions {
     std::vector<std::string> scenes;  // files or directories; empty: the default set
     bool quick = false;               // fewer settings, smaller images (CI)
-    int size = 0;                     // image side; 0: 256 (quick: 48)
+    int size = 0;                     // image side; 0: 128 (quick: 48)
     int runs = 5;                     // timed runs per setting, after one warm-up
     std::string outDir = "bench/results";
     std::string sourceDir;            // the repository (scenes/, bench/make_scaling_scene.py)

@@ -104,12 +104,12 @@ ComputeRenderer::ComputeRenderer(vk::Context& context, const Scene& scene, const
         upload(SNELL_BINDING_BVH, layout_.nodes, VK_FORMAT_R32G32B32A32_UINT, "BVH nodes");
         // Small scenes: the spheres again, as a uniform block (shared_layout.h);
         // for fp64 their low parts follow in the same buffer.
-        std::array<gpu::UnrolledSpheres, 2> blocks{};
-        if (!layout_.usesBvh() && layout_.spheres.size() <= SNELL_MAX_UNROLLED_SPHERES) {
+        std::vector<gpu::SphereBlock> blocks(2);
+        if (spheresInBlock()) {
             std::copy(layout_.spheres.begin(), layout_.spheres.end(), blocks[0].spheres);
             std::copy(layout_.sphereLows.begin(), layout_.sphereLows.end(), blocks[1].spheres);
         }
-        const std::size_t blockBytes = (precision == gpu::Precision::Fp64 ? 2 : 1) * sizeof(gpu::UnrolledSpheres);
+        const std::size_t blockBytes = (precision == gpu::Precision::Fp64 ? 2 : 1) * sizeof(gpu::SphereBlock);
         sceneBuffers_[SNELL_BINDING_SPHERE_BLOCK] =
             context_.createBufferWithData(blocks.data(), blockBytes, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
         if (precision == gpu::Precision::Fp64) {
@@ -122,6 +122,10 @@ ComputeRenderer::ComputeRenderer(vk::Context& context, const Scene& scene, const
         throw;
     }
     uploadMs_ = msSince(start);
+}
+
+bool ComputeRenderer::spheresInBlock() const {
+    return !layout_.usesBvh() && layout_.spheres.size() <= SNELL_BLOCK_SPHERES;
 }
 
 ComputeRenderer::~ComputeRenderer() {
@@ -145,6 +149,7 @@ ComputeRenderer::Specialisation ComputeRenderer::specialise(const RenderRequest&
     values[SNELL_SPEC_USE_BVH] = layout_.usesBvh();
     const bool unrolled = !layout_.usesBvh() && layout_.spheres.size() <= SNELL_MAX_UNROLLED_SPHERES;
     values[SNELL_SPEC_SPHERE_COUNT] = unrolled ? static_cast<std::uint32_t>(layout_.spheres.size()) : 0u;
+    values[SNELL_SPEC_SPHERES_IN_BLOCK] = spheresInBlock();
     if (unrolled)
         for (std::size_t i = 0; i < layout_.spheres.size(); ++i)
             if (layout_.spheres[i].anchorRadius.w < 0.0f) values[SNELL_SPEC_ELLIPSOID_MASK] |= 1u << i;

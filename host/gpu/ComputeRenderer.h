@@ -56,6 +56,7 @@ private:
     void createPipeline(const Specialisation& values, Pipeline& pipeline);
     void destroyPipeline(Pipeline& pipeline);
     void destroyBuffers();
+    bool spheresInBlock() const;  // every sphere in the uniform block (shared_layout.h)
 
     vk::Context& context_;
     const Scene& scene_;

@@ -20,7 +20,7 @@ static_assert(sizeof(Ellipsoid) == 48 && offsetof(Ellipsoid, row2) == 32);
 static_assert(sizeof(Material) == 48 && offsetof(Material, kt) == 32);
 static_assert(sizeof(Light) == 32 && offsetof(Light, colour) == 16);
 static_assert(sizeof(BvhNode) == 32 && offsetof(BvhNode, upper) == 16);
-static_assert(sizeof(UnrolledSpheres) == 32 * SNELL_MAX_UNROLLED_SPHERES);
+static_assert(sizeof(SphereBlock) == 32 * SNELL_BLOCK_SPHERES);
 static_assert(sizeof(FrameParams) == 144 && offsetof(FrameParams, cornerDir) == 16 &&
               offsetof(FrameParams, imageWidth) == 96 && offsetof(FrameParams, bvhNodeCount) == 120 &&
               offsetof(FrameParams, sampleCount) == 128);
