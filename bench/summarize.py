@@ -94,19 +94,20 @@ def pareto(points):
     return front
 
 
-def plot(d, path):
+def plot(d, path, only=None):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     from matplotlib.ticker import FuncFormatter, LogFormatterSciNotation, LogLocator, NullFormatter
 
-    results = [r for r in d["results"] if not r["failure"]]
+    results = [r for r in d["results"] if not r["failure"]
+               and (not only or any(r["scene"].startswith(prefix) for prefix in only))]
     scenes = []
     for r in results:
         if r["scene"] not in scenes:
             scenes.append(r["scene"])
     floor = 1e-3  # an exact result still needs a place on a log axis
-    columns = 4
+    columns = min(4, len(scenes))
     rows = math.ceil(len(scenes) / columns)
     fig, axes = plt.subplots(rows, columns, figsize=(4.2 * columns, 3.4 * rows), squeeze=False)
     for ax in axes.flat[len(scenes):]:
@@ -145,11 +146,13 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("json", help="bench.json written by snell bench")
     parser.add_argument("--plot", metavar="PNG", help="also draw time against error into this PNG")
+    parser.add_argument("--only", metavar="PREFIX", action="append",
+                        help="plot only the scenes whose name starts so (e.g. bench/); repeatable")
     args = parser.parse_args()
     d = json.load(open(args.json))
     tables(d)
     if args.plot:
-        plot(d, args.plot)
+        plot(d, args.plot, args.only)
 
 
 if __name__ == "__main__":

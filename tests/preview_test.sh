@@ -3,8 +3,8 @@
 # swapchain, with the Khronos validation layer on: the scripted screenshot of
 # a scene with reflection and refraction equals `snell render` of it (within
 # the GPU-vs-CPU thresholds), an orbit changes it, saving the scene file
-# re-renders it, a broken save is reported as FILE:LINE:COL and survived, and
-# no display is a clear error.
+# re-renders it, a broken save is reported as FILE:LINE:COL and survived, a
+# moving camera renders small frames, and no display is a clear error.
 set -u
 : "${SNELL:?}" "${SCENES:?}"
 work=$(mktemp -d)
@@ -43,6 +43,12 @@ grep -q "validation" "$work/err" && bad "validation layer messages: $(cat "$work
 "$SNELL" compare --json "$work/orbit.png" "$work/render.png" >"$work/cmp" &&
   python3 -c 'import json,sys; d=json.load(sys.stdin); sys.exit(0 if d["mean_abs_error"] > 1 else 1)' <"$work/cmp" && ok ||
   bad "the orbit did not change the image: $(cat "$work/cmp")"
+
+# The moving camera: every frame orbits, as a drag would, and is rendered small
+# enough to keep up (the frame rate is reported, never asserted here).
+"$SNELL" preview "$scene" --size 256 --frames 8 --orbit-per-frame 3 2>"$work/err"; status=$?
+[ $status -eq 0 ] && grep -q "rendered (moving, [0-9]*x[0-9]* of 256x256).*frames a second" "$work/err" && ok ||
+  bad "moving preview (status $status): $(cat "$work/err")"
 
 # Hot reload: a running preview re-renders a saved change, reports a broken
 # save as FILE:LINE:COL and keeps going; Ctrl-C closes it (status 130).

@@ -434,6 +434,9 @@ int main(int argc, char** argv) {
         ->check(CLI::PositiveNumber);
     preview->add_option("--screenshot", po.screenshot, "Scripted: the PNG to save after --frames frames")->needs(frames);
     preview->add_option("--orbit", po.orbitDegrees, "Scripted: orbit the camera by DEGREES before the first frame");
+    preview->add_option("--orbit-per-frame", po.orbitPerFrame,
+                        "Scripted: orbit the camera by DEGREES before every frame, as a drag would (the moving camera)")
+        ->needs(frames);
 
     snell::BenchOptions bo;
     bo.cancel = &gInterrupted;

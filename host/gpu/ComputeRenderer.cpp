@@ -63,8 +63,10 @@ struct ComputeRenderer::Pipeline {
     std::uint32_t bindingCount = SNELL_BINDING_COUNT_FP32;
     // What it was built for: kept between renders and reused while these match.
     Specialisation values{};
-    int tileW = 0, tileH = 0;
-    std::uint32_t slots = 0;  // persistent invocations a dispatch
+    // What its buffers hold: reused by renders that need no more (the preview
+    // alternates sizes while the camera moves).
+    VkDeviceSize tilePixels = 0;
+    VkDeviceSize slots = 0;  // persistent invocations
 };
 
 ComputeRenderer::ComputeRenderer(vk::Context& context, const Scene& scene, const Camera& camera,
@@ -324,17 +326,14 @@ GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool count
                 SNELL_WORKGROUP_SIZE;
         result.invocations = static_cast<int>(slots);
 
-        // The pipeline and the tile's buffers of the last render serve again
-        // when the specialisation and tile size are the same (the preview).
-        const bool reuse = cached_ && cached_->values == values && cached_->tileW == tileW &&
-                           cached_->tileH == tileH && cached_->slots == slots;
+        // The pipeline of the last render serves again when the specialisation
+        // is the same, and its buffers when they are large enough (the preview).
+        const bool reuse = cached_ && cached_->values == values;
         if (!reuse) {
             if (cached_) destroyPipeline(*cached_);
             cached_ = std::make_unique<Pipeline>();
             createPipeline(values, *cached_);
-            cached_->tileW = tileW;
-            cached_->tileH = tileH;
-            cached_->slots = static_cast<std::uint32_t>(slots);
+            cached_->counters = context_.createBuffer(SNELL_COUNTER_COUNT * sizeof(std::uint32_t), kStorage, true);
         }
         Pipeline& p = *cached_;
 
@@ -347,17 +346,22 @@ GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool count
         p.frame = context_.createBufferWithData(&frame, sizeof frame, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
         if (wide)
             p.frameLow = context_.createBufferWithData(&frameLow, sizeof frameLow, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
-        if (!reuse) {
-            p.counters = context_.createBuffer(SNELL_COUNTER_COUNT * sizeof(std::uint32_t), kStorage, true);
+        if (slots > p.slots) {
+            for (vk::Buffer* b : {&p.slotStates, &p.rayStack, &p.mediaStack, &p.rayStackLow}) context_.destroy(*b);
+            p.slots = slots;
             // Host-visible: the host reads the invocations' progress while they run.
             p.slotStates = context_.createBuffer(slots * sizeof(gpu::SlotState), kStorage, true);
             p.rayStack = context_.createBuffer(slots * p.rayStackDepth * sizeof(gpu::PendingRay), kStorage, false);
             p.mediaStack = context_.createBuffer(slots * p.rayStackDepth * p.maxMedia * 4, kStorage, false);
             if (wide)
                 p.rayStackLow = context_.createBuffer(slots * p.rayStackDepth * sizeof(gpu::PendingRay), kStorage, false);
+        }
+        if (tilePixels > p.tilePixels) {
+            context_.destroy(p.output);
+            p.tilePixels = tilePixels;
             // The tile's pixels, which the host reads where the shader wrote them
             // (on lavapipe, an imageStore in a loop costs 13x a buffer store).
-            p.output = context_.createBuffer(VkDeviceSize(tileW) * tileH * 4 * sizeof(float), kStorage, true);
+            p.output = context_.createBuffer(tilePixels * 4 * sizeof(float), kStorage, true);
         }
 
         std::array<VkDescriptorBufferInfo, SNELL_BINDING_COUNT> bufferInfo{};

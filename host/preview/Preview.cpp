@@ -43,6 +43,12 @@ double msBetween(Clock::time_point a, Clock::time_point b) {
     return std::chrono::duration<double, std::milli>(b - a).count();
 }
 
+// The moving camera: frames rendered small enough to take at most this long
+// (10 frames a second with room for the rest of the loop), and the camera
+// counts as still this long after its last move.
+constexpr double kMovingFrameMs = 60.0;
+constexpr double kStillAfterMs = 150.0;
+
 // What the window's callbacks tell the loop.
 struct Input {
     OrbitCamera* camera = nullptr;
@@ -127,6 +133,8 @@ private:
     void updateTitle();
     void saveScreenshot(const std::string& path);
     void resetAccumulation() { samplesDone_ = 0; }
+    bool moving() const;
+    void chooseMovingScale();
     int supersample() const { return supersampleOn_ ? std::max(2, sceneSupersample()) : 1; }
     int sceneSupersample() const { return o_.supersample.value_or(scene_->supersample); }
 
@@ -147,6 +155,11 @@ private:
     std::vector<std::uint8_t> bytes_;
     bool haveImage_ = false;
     double lastFrameMs_ = 0.0, lastRaysPerSecond_ = 0.0;
+    // While the camera moves, frames are rendered 1/movingScale_ a side, one
+    // sample each, sized to keep kMovingFrameMs; still, the full image refines.
+    int movingScale_ = 1;
+    int frameSide_ = 0;  // the side of the image in bytes_
+    Clock::time_point lastMove_{};
     std::string error_;  // the last reload's error, shown in the title
     fs::file_time_type sceneTime_{};
     Clock::time_point lastPoll_{};
@@ -218,31 +231,56 @@ void Session::saveScreenshot(const std::string& path) {
     if (!o_.quiet) std::cerr << "snell: screenshot " << path << "\n";
 }
 
+// The camera moved within the last moment (or a drag holds it).
+bool Session::moving() const {
+    return input_.dragging || msBetween(lastMove_, Clock::now()) < kStillAfterMs;
+}
+
+// The scale that keeps a moving frame within kMovingFrameMs, from the last
+// frame's time: the render time goes with the number of pixels.
+void Session::chooseMovingScale() {
+    if (lastFrameMs_ <= 0.0) return;
+    const double fullMs = lastFrameMs_ * double(movingScale_) * double(movingScale_);
+    int scale = 1;
+    while (scale < size_ / 16 && fullMs / double(scale * scale) > kMovingFrameMs) ++scale;
+    movingScale_ = scale;
+}
+
 void Session::renderFrame() {
+    // Moving: a quick low-resolution look, one sample, nothing accumulated.
+    const bool quick = moving();
+    const int side = quick ? std::max(1, size_ / movingScale_) : size_;
     RenderRequest request;
-    request.width = request.height = size_;
-    request.supersample = supersample();
-    request.firstSample = samplesDone_;
+    request.width = request.height = side;
+    request.supersample = quick ? 1 : supersample();
+    request.firstSample = quick ? 0 : samplesDone_;
     request.sampleCount = 1;  // progressive: one sub-pixel sample a frame
-    request.camera = camera_.camera(size_, size_);
+    request.camera = camera_.camera(side, side);
     request.trace = trace_;
     request.cancel = o_.cancel;
     const GpuRenderResult r = renderer_->render(request, true);
-    if (samplesDone_ == 0) std::fill(sum_.rgb.begin(), sum_.rgb.end(), 0.0f);
-    for (std::size_t i = 0; i < sum_.rgb.size(); ++i) sum_.rgb[i] += r.image.rgb[i];
-    ++samplesDone_;
-    mean_ = Image(size_, size_);
-    const float inverse = 1.0f / float(samplesDone_);
-    for (std::size_t i = 0; i < sum_.rgb.size(); ++i)
-        mean_.rgb[i] = samplesDone_ == 1 ? sum_.rgb[i] : sum_.rgb[i] * inverse;
-    bytes_.resize(std::size_t(size_) * size_ * 4);
-    for (std::size_t p = 0; p < std::size_t(size_) * size_; ++p) {
+    if (quick) {
+        mean_ = r.image;
+        samplesDone_ = 0;  // the full image starts afresh once the camera stops
+    } else {
+        if (samplesDone_ == 0) std::fill(sum_.rgb.begin(), sum_.rgb.end(), 0.0f);
+        for (std::size_t i = 0; i < sum_.rgb.size(); ++i) sum_.rgb[i] += r.image.rgb[i];
+        ++samplesDone_;
+        mean_ = Image(size_, size_);
+        const float inverse = 1.0f / float(samplesDone_);
+        for (std::size_t i = 0; i < sum_.rgb.size(); ++i)
+            mean_.rgb[i] = samplesDone_ == 1 ? sum_.rgb[i] : sum_.rgb[i] * inverse;
+    }
+    frameSide_ = side;
+    bytes_.resize(std::size_t(side) * side * 4);
+    for (std::size_t p = 0; p < std::size_t(side) * side; ++p) {
         for (int k = 0; k < 3; ++k) bytes_[p * 4 + k] = toByte(mean_.rgb[p * 3 + k]);
         bytes_[p * 4 + 3] = 255;
     }
     haveImage_ = true;
     lastFrameMs_ = r.renderMs;
     lastRaysPerSecond_ = r.renderMs > 0.0 ? double(r.rays.total()) / (r.renderMs * 1e-3) : 0.0;
+    if (quick) chooseMovingScale();
 }
 
 void Session::updateTitle() {
@@ -253,7 +291,9 @@ void Session::updateTitle() {
         t << " | " << error_;
     } else {
         const int s = supersample();
-        t << " | " << lastFrameMs_ << " ms/frame, " << lastRaysPerSecond_ * 1e-6 << " Mrays/s | depth "
+        t << " | " << lastFrameMs_ << " ms/frame, " << lastRaysPerSecond_ * 1e-6 << " Mrays/s";
+        if (frameSide_ != size_) t << ", moving: " << frameSide_ << "x" << frameSide_;
+        t << " | depth "
           << trace_.maxDepth << ", shadows " << (trace_.shadows ? "on" : "off") << ", reflection "
           << (trace_.reflection ? "on" : "off") << ", refraction " << (trace_.refraction ? "on" : "off") << ", spp "
           << s << "x" << s << " (" << samplesDone_ << "/" << s * s << ")";
@@ -326,11 +366,16 @@ void Session::run() {
     Clock::time_point lastShown = Clock::now();
     while (!glfwWindowShouldClose(window_)) {
         if (o_.cancel && o_.cancel->load()) break;
-        const bool refining = samplesDone_ < supersample() * supersample();
+        const bool refining = samplesDone_ < supersample() * supersample() || frameSide_ != size_;
         if (refining || o_.frames > 0) glfwPollEvents();
         else glfwWaitEventsTimeout(0.25);  // idle: sleep, waking only to look at the scene file
+        if (o_.frames > 0 && o_.orbitPerFrame != 0.0) {  // scripted drag
+            camera_.orbitDegrees(o_.orbitPerFrame);
+            input_.cameraMoved = true;
+        }
         if (input_.cameraMoved) {
             input_.cameraMoved = false;
+            lastMove_ = Clock::now();
             resetAccumulation();
         }
         handleKeys();
@@ -353,13 +398,13 @@ void Session::run() {
         // Scripted, every pass shows a frame (the finished image again once refined).
         bool show = (input_.redraw || o_.frames > 0) && haveImage_;
         bool rendered = false;
-        if (samplesDone_ < supersample() * supersample()) {
+        if (samplesDone_ < supersample() * supersample() || moving() || frameSide_ != size_) {
             renderFrame();
             show = rendered = true;
         }
         if (!show) continue;
         input_.redraw = false;
-        if (!presenter_->present(bytes_, size_, size_)) {
+        if (!presenter_->present(bytes_, frameSide_, frameSide_)) {
             input_.redraw = true;  // the swapchain was rebuilt: show it again next time round
             continue;
         }
@@ -393,9 +438,12 @@ void Session::run() {
             std::sort(v.begin(), v.end());
             return v[v.size() / 2];
         };
-        std::cerr << "snell: " << framesShown << " frames shown, " << frameMs.size() << " rendered at " << size_
-                  << "x" << size_ << ": median " << median(renderMs) << " ms rendering, " << median(frameMs)
-                  << " ms a frame in all\n";
+        std::cerr << "snell: " << framesShown << " frames shown, " << frameMs.size() << " rendered ("
+                  << (o_.orbitPerFrame != 0.0 ? "moving, " + std::to_string(frameSide_) + "x" +
+                                                    std::to_string(frameSide_) + " of "
+                                              : std::string())
+                  << size_ << "x" << size_ << "): median " << median(renderMs) << " ms rendering, "
+                  << median(frameMs) << " ms a frame in all (" << 1000.0 / median(frameMs) << " frames a second)\n";
     }
     if (o_.validation && context_->validationMessages() > 0)
         throw vk::VulkanError("the Vulkan validation layer reported " +

@@ -28,10 +28,12 @@ struct PreviewOptions {
     gpu::Precision precision = gpu::Precision::Fp32;
     bool quiet = false;
     // Scripted mode: after `frames` frames (> 0), save `screenshot` (when set)
-    // and return. `orbitDegrees` orbits the camera before the first frame.
+    // and return. `orbitDegrees` orbits the camera before the first frame;
+    // `orbitPerFrame` before every frame, as a drag would (the moving camera).
     int frames = 0;
     std::string screenshot;
     double orbitDegrees = 0.0;
+    double orbitPerFrame = 0.0;
     const std::atomic<bool>* cancel = nullptr;  // set to close the window
     std::string pipelineCachePath;              // vk::ContextOptions::pipelineCachePath
 };
