@@ -3,7 +3,7 @@
 // the renderer stores them), against the double one the reference uses
 // (host/reference/Intersect.h), on random spheres, ellipsoids and rays at
 // scales from 1e-4 to 1e6: hit/miss disagreement and relative t error.
-// The bounds are documented in README ("Numerical robustness").
+// The bounds are documented in docs/accuracy.md ("Numerical robustness").
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -115,7 +115,7 @@ struct Bounds {
     const char* name;
     const std::uint32_t* spirv;
     std::size_t spirvBytes;
-    // Documented bounds (README): disagreements are grazing rays whose answer
+    // Documented bounds (docs/accuracy.md): disagreements are grazing rays whose answer
     // the precision cannot resolve.
     double disagreement, p50, p99, surfaceDisagreement, surfaceP99;
 };

@@ -484,7 +484,7 @@ int main(int argc, char** argv) {
     }
     std::signal(SIGINT, onSignal);
     std::signal(SIGTERM, onSignal);
-    // A testing hook (README, "Tests"): simulate a failing GPU.
+    // A testing hook (docs/testing.md, "Faults and limits"): simulate a failing GPU.
     if (const char* fault = std::getenv("SNELL_INJECT_FAULT"); fault && *fault) {
         try {
             ro.fault = snell::vk::parseFaultInjection(fault);

@@ -22,7 +22,7 @@ struct TraceSettings {
 
 // The converged settings used to compute the exact image (SPEC §4).
 inline constexpr TraceSettings kReferenceSettings{64, 1e-7, true, true, true};
-// What `snell render` uses unless told otherwise (see README, "Defaults").
+// What `snell render` uses unless told otherwise (docs/design.md, "Defaults").
 inline constexpr TraceSettings kDefaultSettings{64, 1e-4, true, true, true};
 
 struct RayCounts {
