@@ -30,10 +30,16 @@ grep -q "^$work/bad.scn:3:9: error: " "$work/err" && ok || bad "error format: $(
 "$SNELL" render "$work" -o "$work/x.png" 2>"$work/err"; status=$?
 [ $status -eq 2 ] && grep -q "directory" "$work/err" && ok || bad "directory as input ($status)"
 
-# Bad command line: status 2. Unknown output format / unwritable dir: status 1 before rendering.
-"$SNELL" render "$SCENES/basic.scn" --size 0 -o "$work/x.png" 2>/dev/null; [ $? -eq 2 ] && ok || bad "--size 0"
+# Bad command line, an unknown output format included: status 2 with a message,
+# nothing rendered. An unwritable directory: status 1 before rendering.
+for args in "--size 0" "--min-weight nan" "--min-weight inf" "--min-weight -1" "--depth x" "--precision fp16"; do
+  # shellcheck disable=SC2086
+  "$SNELL" render "$SCENES/basic.scn" $args -o "$work/x.png" 2>"$work/err"; status=$?
+  [ $status -eq 2 ] && [ -s "$work/err" ] && [ ! -e "$work/x.png" ] && ok || bad "render $args: status $status"
+done
+"$SNELL" preview "$SCENES/basic.scn" --orbit nan 2>/dev/null; [ $? -eq 2 ] && ok || bad "preview --orbit nan"
 "$SNELL" render "$SCENES/basic.scn" -o "$work/x.jpg" 2>"$work/err"; status=$?
-[ $status -eq 1 ] && grep -q ".png, .ppm, .pfm or .exr" "$work/err" && ok || bad "unknown extension ($status)"
+[ $status -eq 2 ] && grep -q ".png, .ppm, .pfm or .exr" "$work/err" && ok || bad "unknown extension ($status)"
 "$SNELL" render "$SCENES/basic.scn" -o "$work/no/such/dir/x.png" 2>"$work/err"; status=$?
 [ $status -eq 1 ] && grep -q "does not exist" "$work/err" && ok || bad "missing output dir ($status)"
 
@@ -68,14 +74,20 @@ head -c 2 "$work/basic.pfm" | grep -q PF && ok || bad "PFM magic"
 "$SNELL" render "$SCENES/basic.scn" --size 32 -o "$work/basic.exr" -q && "$SNELL" compare --json "$work/basic.exr" "$work/basic.pfm" |
   grep -q '"max_error": 0' && ok || bad "EXR output"
 
-# Ctrl-C during a long render: status 130, no output file, no temporary left.
-"$SNELL" render "$SCENES/showcase.scn" --size 4096 --cpu -o "$work/interrupted.png" 2>/dev/null &
-pid=$!
-sleep 1
-kill -INT $pid
-wait $pid; status=$?
-[ $status -eq 130 ] && [ ! -e "$work/interrupted.png" ] && ! ls "$work" | grep -q "interrupted.png.tmp" && ok ||
-  bad "interrupted render (status $status): $(ls "$work")"
+# Ctrl-C, SIGTERM or SIGHUP during a long render (CPU and GPU): status 128 +
+# the signal, no output file, no temporary left.
+for sig in INT:130 TERM:143 HUP:129; do
+  for device in --cpu ""; do
+    # shellcheck disable=SC2086
+    "$SNELL" render "$SCENES/showcase.scn" --size 4096 $device -o "$work/interrupted.png" 2>/dev/null &
+    pid=$!
+    sleep 1
+    kill -"${sig%%:*}" $pid
+    wait $pid; status=$?
+    [ $status -eq "${sig##*:}" ] && [ ! -e "$work/interrupted.png" ] && ! ls "$work" | grep -q "interrupted.png.tmp" && ok ||
+      bad "render ${device:-(GPU)} ended by SIG${sig%%:*} (status $status): $(ls "$work")"
+  done
+done
 
 # A GPU that fails mid-render (simulated by the SNELL_INJECT_FAULT hook): the
 # device is lost after the first band of rows has been streamed (1100² is 2x2

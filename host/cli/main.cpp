@@ -1,7 +1,9 @@
 // snell's command line: the only place that maps errors to exit statuses.
-//   0 success · 1 runtime failure (Vulkan, files) · 2 bad scene or command line · 130 interrupted
+//   0 success · 1 runtime failure (Vulkan, files) · 2 bad scene or command line ·
+//   128 + N ended by signal N (SIGINT 130, SIGHUP 129, SIGTERM 143)
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <cstdlib>
 #include <cstdio>
@@ -42,15 +44,41 @@ double msSince(Clock::time_point start) {
 
 constexpr int kExitRuntime = 1;
 constexpr int kExitInput = 2;
-constexpr int kExitInterrupted = 130;
 constexpr int kMaxGpuDepth = 256;
 
+// A termination signal asks the render to stop; the temporary output is
+// removed and the status is the shell's convention for death by that signal.
 std::atomic<bool> gInterrupted{false};
-extern "C" void onSignal(int) { gInterrupted.store(true); }
+volatile std::sig_atomic_t gSignal = 0;
+extern "C" void onSignal(int signal) {
+    gSignal = signal;
+    gInterrupted.store(true);
+}
+int interruptedStatus() { return 128 + (gSignal != 0 ? int(gSignal) : SIGINT); }
+
+// The output's format comes from its extension; an unknown one is a command-line error.
+const CLI::Validator kImageFormat(
+    [](const std::string& path) {
+        try {
+            snell::formatForPath(path);
+            return std::string();
+        } catch (const snell::ImageIOError& e) {
+            return std::string(e.what());
+        }
+    },
+    "IMAGE");
+
+// CLI11's Range lets NaN through (every comparison with it is false).
+const CLI::Validator kFinite(
+    [](const std::string& text) {
+        const double value = std::strtod(text.c_str(), nullptr);
+        return std::isfinite(value) ? std::string() : std::string("must be a finite number");
+    },
+    "FINITE");
 
 const char* kExitStatuses =
     "Exit status: 0 success; 1 runtime failure (no Vulkan device, device lost, unwritable output);\n"
-    "2 bad scene file or command line (the message is FILE:LINE:COL: error: ...); 130 interrupted.";
+    "2 bad scene file or command line (the message is FILE:LINE:COL: error: ...); 128+N ended by signal N (Ctrl-C: 130).";
 
 struct RenderOptions {
     std::string scene;
@@ -218,7 +246,7 @@ int runRender(const RenderOptions& o) {
         } catch (const snell::vk::VulkanError& e) {
             if (gInterrupted.load()) {
                 std::cerr << "\nsnell: interrupted; no image written\n";
-                return kExitInterrupted;
+                return interruptedStatus();
             }
             std::cerr << "snell: error: " << e.what() << "\n";
             return kExitRuntime;
@@ -226,7 +254,7 @@ int runRender(const RenderOptions& o) {
     }
     if (gInterrupted.load()) {
         std::cerr << "\nsnell: interrupted; no image written\n";
-        return kExitInterrupted;
+        return interruptedStatus();
     }
     if (!writeError.empty()) {
         std::cerr << "snell: error: " << writeError << "\n";
@@ -304,14 +332,14 @@ int runPreviewCommand(const snell::PreviewOptions& o) {
         std::cerr << e.what() << "\n";
         return kExitInput;
     } catch (const snell::vk::VulkanError& e) {
-        if (gInterrupted.load()) return kExitInterrupted;
+        if (gInterrupted.load()) return interruptedStatus();
         std::cerr << "snell: error: " << e.what() << "\n";
         return kExitRuntime;
     } catch (const std::runtime_error& e) {  // WindowError, ImageIOError
         std::cerr << "snell: error: " << e.what() << "\n";
         return kExitRuntime;
     }
-    return gInterrupted.load() ? kExitInterrupted : 0;
+    return gInterrupted.load() ? interruptedStatus() : 0;
 }
 
 int runBenchCommand(snell::BenchOptions o) {
@@ -327,7 +355,7 @@ int runBenchCommand(snell::BenchOptions o) {
         std::cerr << e.what() << "\n";
         return kExitInput;
     } catch (const std::exception& e) {
-        if (gInterrupted.load()) return kExitInterrupted;
+        if (gInterrupted.load()) return interruptedStatus();
         std::cerr << "snell: error: " << e.what() << "\n";
         return kExitRuntime;
     }
@@ -390,14 +418,15 @@ int main(int argc, char** argv) {
     RenderOptions ro;
     CLI::App* render = app.add_subcommand("render", "Render a scene file to an image (PNG, PPM, PFM or EXR by extension)");
     render->add_option("scene", ro.scene, "Scene file")->required();
-    render->add_option("-o,--output", ro.output, "Output image: .png, .ppm (P6), .pfm or .exr (float); - for PPM on standard output; default SCENE.png");
+    render->add_option("-o,--output", ro.output, "Output image: .png, .ppm (P6), .pfm or .exr (float); - for PPM on standard output; default SCENE.png")
+        ->check(kImageFormat);
     render->add_flag("--cpu", ro.cpu, "Render with the double-precision CPU reference instead of the GPU");
     render->add_option("-s,--size", ro.size, "Image size in pixels (overrides the scene's view n)")
         ->check(CLI::Range(1, snell::ParseLimits::kMaxImageSize));
     render->add_option("-d,--depth", ro.depth, "Maximum reflection/refraction depth (default: 64)")
         ->check(CLI::Range(0, 100000));
     render->add_option("--min-weight", ro.minWeight, "Stop rays whose weight falls below W; 0 disables (default: GPU 1e-4, CPU 1e-7)")
-        ->check(CLI::Range(0.0, 1.0));
+        ->check(kFinite)->check(CLI::Range(0.0, 1.0));
     render->add_option("--spp,--supersample", ro.supersample, "Rays per pixel per axis (overrides the scene's supersample)")
         ->check(CLI::Range(1, snell::ParseLimits::kMaxSupersample));
     render->add_option("--gpu", ro.gpu, "Vulkan device index (see 'snell devices'; default: $SNELL_GPU, else the best)")
@@ -421,7 +450,7 @@ int main(int argc, char** argv) {
         ->check(CLI::Range(1, 4096));
     preview->add_option("-d,--depth", po.depth, "Initial maximum depth (default: 64)")->check(CLI::Range(0, 256));
     preview->add_option("--min-weight", po.minWeight, "Stop rays whose weight falls below W (default: 1e-4)")
-        ->check(CLI::Range(0.0, 1.0));
+        ->check(kFinite)->check(CLI::Range(0.0, 1.0));
     preview->add_option("--spp,--supersample", po.supersample, "Rays per pixel per axis when supersampling is on")
         ->check(CLI::Range(1, snell::ParseLimits::kMaxSupersample));
     preview->add_option("--gpu", po.gpu, "Vulkan device index (default: $SNELL_GPU, else the best)")
@@ -433,10 +462,11 @@ int main(int argc, char** argv) {
     CLI::Option* frames = preview->add_option("--frames", po.frames, "Scripted: show N frames, then save --screenshot and exit")
         ->check(CLI::PositiveNumber);
     preview->add_option("--screenshot", po.screenshot, "Scripted: the PNG to save after --frames frames")->needs(frames);
-    preview->add_option("--orbit", po.orbitDegrees, "Scripted: orbit the camera by DEGREES before the first frame");
+    preview->add_option("--orbit", po.orbitDegrees, "Scripted: orbit the camera by DEGREES before the first frame")
+        ->check(kFinite);
     preview->add_option("--orbit-per-frame", po.orbitPerFrame,
                         "Scripted: orbit the camera by DEGREES before every frame, as a drag would (the moving camera)")
-        ->needs(frames);
+        ->check(kFinite)->needs(frames);
 
     snell::BenchOptions bo;
     bo.cancel = &gInterrupted;
@@ -484,6 +514,7 @@ int main(int argc, char** argv) {
     }
     std::signal(SIGINT, onSignal);
     std::signal(SIGTERM, onSignal);
+    std::signal(SIGHUP, onSignal);
     // A testing hook (docs/testing.md, "Faults and limits"): simulate a failing GPU.
     if (const char* fault = std::getenv("SNELL_INJECT_FAULT"); fault && *fault) {
         try {
