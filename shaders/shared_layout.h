@@ -85,7 +85,11 @@ using uint = std::uint32_t;
 #define SNELL_RAY_COUNTER_COUNT 4
 #define SNELL_COUNTER_UNFINISHED 4  // invocations still tracing after this dispatch
 #define SNELL_COUNTER_LOOP_LIMIT 5  // subgroups that may have hit the driver's loop limit
-#define SNELL_COUNTER_COUNT 6
+#define SNELL_COUNTER_DEEPEST 6     // the deepest ray traced (atomicMax)
+#define SNELL_COUNTER_OVERFLOW 7    // rays dropped because an invocation's ray stack was full
+#define SNELL_COUNTER_OVER_BUDGET 8 // pixels with a sample whose tree reached the tree budget
+#define SNELL_COUNTER_CANCEL 9      // set by the host while a dispatch runs: take no new pixel
+#define SNELL_COUNTER_COUNT 10
 
 // Mesa's llvmpipe before 24 (lavapipe in Debian 12's Mesa 22.3) ends every
 // loop of a shader once one SIMD row has run 65535 loop iterations in total in
@@ -160,10 +164,17 @@ struct BvhNode {
 // An invocation's progress between dispatches (one per invocation).
 struct SlotState {
     vec4 sum;        // rgb: the current pixel's finished samples and the current one so far
+    vec4 dropped;    // rgb: the weight of its rays not traced (render/Truncation.h); w: its cut-off
+    vec4 lower;      // rgb: the pixel's best lower and upper bounds over its attempts so far
+    vec4 upper;      //      (render/Truncation.h, PixelEstimate)
     uint pixel;      // the pixel of the tile in progress (row-major); ≥ tile size: done
     uint started;    // samples of it started
     uint pending;    // rays waiting on this invocation's stack
     uint finished;   // pixels finished so far in this tile (read by the host for progress)
+    uint treeRays;   // rays the current sample's tree has traced
+    uint overBudget; // 1: a sample of the current pixel reached the tree budget
+    uint rays;       // rays traced so far in this tile (read by the host for progress)
+    uint pad0;
 };
 
 // A ray waiting to be traced (SPEC §4 ray tree, depth first). Its medium stack
@@ -189,7 +200,9 @@ struct FrameParams {
     vec4 pixelRight;    // xyz: one pixel step along a row
     vec4 pixelDown;     // xyz: one pixel step down a column
     vec4 background;    // rgb background, w = eta of air
-    vec4 ambient;       // rgb ambient, w = minimum ray weight
+    vec4 ambient;       // rgb ambient, w = minimum ray weight (with a tolerance: the lowest cut-off tried)
+    vec4 radiance;      // rgb: the radiance bound R (render/Truncation.h), +inf where light need not decay;
+                        // w: the tolerance on each pixel's truncation bound, 0: none
     uint imageWidth;
     uint imageHeight;
     uint supersample;
@@ -199,9 +212,9 @@ struct FrameParams {
     uint bvhNodeCount;
     uint firstSample;   // trace sub-pixel samples firstSample .. firstSample + sampleCount − 1
     uint sampleCount;   // of the supersample² grid (row-major), and output their mean
+    uint treeBudget;    // the most rays one sample's tree may trace; 0: no limit
     uint pad0;
     uint pad1;
-    uint pad2;
 };
 
 // Push constants: the tile of the image this dispatch covers, and whether it

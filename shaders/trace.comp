@@ -52,7 +52,8 @@ layout(constant_id = SNELL_SPEC_LOOP_BUDGET) const uint LOOP_BUDGET = 0u;
 layout(constant_id = SNELL_SPEC_SHADOWS) const bool SHADOWS = true;
 
 // What the shader writes: the tile's pixels, row-major (a buffer: on lavapipe
-// an imageStore in a loop costs 13x a buffer store), and its own bookkeeping.
+// an imageStore in a loop costs 13x a buffer store; rgb the colour, a the
+// pixel's truncation bound), and its own bookkeeping.
 layout(set = 0, binding = SNELL_BINDING_OUTPUT, std430) writeonly buffer OutputBlock { vec4 outputPixels[]; };
 layout(set = 0, binding = SNELL_BINDING_COUNTERS, std430) buffer CounterBlock { uint counters[]; };
 layout(set = 0, binding = SNELL_BINDING_SLOT_STATES, std430) buffer SlotStateBlock { SlotState slotStates[]; };
@@ -117,6 +118,8 @@ vec4 materialKt(uint m) { return texelFetch(materialTexels, int(3u * m + 2u)); }
 const uint NONE = 0xffffffffu;
 
 uint countedRays[SNELL_RAY_COUNTER_COUNT];
+// Shadow rays this invocation cast in this dispatch (for SlotState.rays).
+uint shadowRays = 0u;
 
 // Loop iterations this subgroup has run in this dispatch, as llvmpipe's loop
 // limiter counts them (at least): it counts every pass of a loop with some lane
@@ -278,10 +281,27 @@ bool occluded(rvec3 origin, rvec3 dir, real distance, uint fromSphere, uint star
 // Each pending ray carries its weight, depth, the sphere it starts on, whether
 // it heads into that sphere, and its medium stack (innermost last).
 
+// The cut-off of the pixel in hand: the minimum weight, or under a tolerance
+// the one its current attempt uses (SlotState.dropped.w).
+float cutOff;
 bool worthTracing(vec3 w) {
     float m = max(w.x, max(w.y, w.z));
-    return m > 0.0 && m >= frame.ambient.w;
+    return m > 0.0 && m >= cutOff;
 }
+// weight ⊙ colour, where a weight grown to +inf (an amplifying tree, SPEC §4)
+// times 0 is 0, not NaN.
+vec3 weighted(vec3 weight, vec3 colour) {
+    bvec3 zero = bvec3(uvec3(equal(colour, vec3(0.0))) | uvec3(equal(weight, vec3(0.0))));
+    return mix(weight * colour, vec3(0.0), zero);
+}
+#define INFINITY uintBitsToFloat(0x7f800000u)
+// The largest weight a ray carries: an amplifying tree's weights grow without
+// end and would overflow to +inf (then inf · 0 = NaN). A capped weight is at
+// most the true one, so every sum stays a lower bound of the exact colour
+// (render/Truncation.h); its twin is in CpuRenderer.cpp.
+const float MAX_WEIGHT = 1e30;
+// The weight of the rays of this pixel not traced (render/Truncation.h).
+vec3 dropped;
 
 // The ray being traced lives in registers; only a deferred child (the
 // reflected one, when a ray also refracts) goes to the stack in device memory,
@@ -356,7 +376,7 @@ bool findHit(Ray r, vec3 weight, inout vec3 sum, out Hit h) {
     real t;
     h.sphere = closestHit(r.origin, r.dir, r.fromSphere, r.inward ? ENTERING : LEAVING, t);
     if (h.sphere == NONE) {
-        sum += weight * frame.background.rgb;
+        sum += weighted(weight, frame.background.rgb);
         return false;
     }
     uint material = sphereMaterial(h.sphere);
@@ -393,11 +413,25 @@ vec3 shadeLight(uint j, Hit h, rvec3 v) {
     float nl = float(dot(h.normal, l));
     if (!(nl > 0.0)) return vec3(0.0);
     if (COUNT_RAYS && SHADOWS) countedRays[SNELL_COUNTER_SHADOW]++;
+    if (SHADOWS) shadowRays++;
     // A shadow ray towards N's side enters the hit sphere only when N = −No.
     if (SHADOWS && occluded(h.point, l, distance, h.sphere, h.fromOutside ? LEAVING : ENTERING)) return vec3(0.0);
     float rv = float(dot(2.0 * dot(h.normal, l) * h.normal - l, v));
     float specular = rv > 0.0 ? pow(rv, h.kd.w) : 0.0;
     return lightColour(j) * (h.kd.rgb * nl + h.ks.rgb * specular);
+}
+
+// What an attempt at a pixel proves of its exact colour: its colour is a lower
+// bound and its colour plus its dropped weight times the radiance bound an
+// upper bound; the pixel keeps the best of each (render/Truncation.h,
+// PixelEstimate, its twin). Returns the bound on the clamped colour.
+float addAttempt(inout SlotState state, vec3 droppedWeight, float samples, out bool unbounded) {
+    vec3 value = state.sum.rgb / samples;
+    state.lower.rgb = max(state.lower.rgb, value);
+    state.upper.rgb = min(state.upper.rgb, value + weighted(droppedWeight, frame.radiance.rgb) / samples);
+    vec3 gap = min(state.upper.rgb, vec3(1.0)) - min(state.lower.rgb, vec3(1.0));
+    unbounded = any(bvec3(uvec3(greaterThan(state.upper.rgb, vec3(3.0e38))) & uvec3(lessThan(state.lower.rgb, vec3(1.0)))));
+    return max(0.0, max(gap.r, max(gap.g, gap.b)));
 }
 
 // 4–5. The children of ray r at hit h: reflection (keeps the medium stack) and
@@ -406,17 +440,21 @@ vec3 shadeLight(uint j, Hit h, rvec3 v) {
 // in the CPU reference.
 void spawnChildren(uint slot, inout uint pending, inout Ray r, vec3 weight, Hit h, out bool hasRay) {
     hasRay = false;
-    if (r.depth >= frame.maxDepth) return;
+    vec3 reflectedGain = HAS_REFLECTION ? h.ks.rgb : vec3(0.0);
+    if (r.depth >= frame.maxDepth) {
+        dropped += weighted(weight, reflectedGain + (HAS_REFRACTION ? h.kt.rgb : vec3(0.0)));
+        return;
+    }
     rvec3 d = r.dir;
     rvec3 n = h.normal;
-    vec3 reflectedWeight = HAS_REFLECTION ? weight * h.ks.rgb : vec3(0.0);
+    vec3 reflectedWeight = min(weighted(weight, reflectedGain), vec3(MAX_WEIGHT));
     bool refracts = false;
     rvec3 refracted = rvec3(0.0);
     vec3 transmittedWeight = vec3(0.0);
     uint removeAt = r.mediaCount;  // leaving: where this sphere is in the stack
     vec4 kt = h.kt;
     if (HAS_REFRACTION && max(kt.r, max(kt.g, kt.b)) > 0.0) {
-        transmittedWeight = weight * kt.rgb;
+        transmittedWeight = min(weighted(weight, kt.rgb), vec3(MAX_WEIGHT));
         real etaI, etaT;
         if (h.fromOutside) {
             // Entering: from the current medium into this sphere.
@@ -440,42 +478,75 @@ void spawnChildren(uint slot, inout uint pending, inout Ray r, vec3 weight, Hit 
         if (k < 0.0) {
             // Total internal reflection is the reflected ray in the same medium:
             // one ray carries both weights.
-            reflectedWeight += transmittedWeight;
+            reflectedWeight = min(reflectedWeight + transmittedWeight, vec3(MAX_WEIGHT));
         } else if (worthTracing(transmittedWeight)) {
             refracts = true;
             refracted = normalize(eta * d + (eta * c - sqrt(k)) * n);
+        } else {
+            dropped += transmittedWeight;
         }
     }
     bool reflects = (HAS_REFLECTION || HAS_REFRACTION) && worthTracing(reflectedWeight);
+    if (!reflects) dropped += reflectedWeight;
     Ray reflectedRay = Ray(h.point, d - 2.0 * dot(d, n) * n, reflectedWeight, r.depth + 1u, h.sphere, !h.fromOutside,
                            r.mediaCount, 0u);
-    if (reflects) {
-        if (COUNT_RAYS) countedRays[SNELL_COUNTER_REFLECTED]++;
-        if (!refracts) {
-            r = reflectedRay;
-            hasRay = true;
-            return;
-        }
-        pushRay(slot, pending, reflectedRay);  // with the parent's media, still current
+    if (reflects && COUNT_RAYS) countedRays[SNELL_COUNTER_REFLECTED]++;
+    if (refracts && COUNT_RAYS) countedRays[SNELL_COUNTER_REFRACTED]++;
+    if (!refracts) {
+        r = reflectedRay;
+        hasRay = reflects;
+        return;
     }
-    if (refracts) {
-        if (COUNT_RAYS) countedRays[SNELL_COUNTER_REFRACTED]++;
-        uint count = r.mediaCount;
-        if (h.fromOutside) {
-            if (count == uint(MAX_MEDIA)) {  // deeper than the scene can nest: forget the outermost
-                [[unroll]] for (int k = 0; k + 1 < MAX_MEDIA; ++k) media[k] = media[k + 1];
-                count--;
+    // Both children: the lighter is traced next and the heavier waits on the
+    // stack, so each waiting ray at least halves (ks + kt <= 1) the weight of
+    // the path below it, and the stack needs no more than log(cut-off) / log(q)
+    // entries however deep the tree (host/gpu/ComputeRenderer.cpp sizes it).
+    bool refractedWaits = false;
+    if (reflects) {
+        // In an amplifying scene (where the stack is sized by depth anyway)
+        // the heavier goes on instead: under a tree budget the weightiest
+        // rays are traced first, which is what saturates a diverging channel.
+        refractedWaits = (max(transmittedWeight.r, max(transmittedWeight.g, transmittedWeight.b)) >
+                          max(reflectedWeight.r, max(reflectedWeight.g, reflectedWeight.b))) != AMPLIFYING;
+        // One entry stays free for the ray in hand should the invocation suspend.
+        if (pending + 1u >= RAY_STACK) {
+            // Full (only an amplifying tree can fill it): the heavier child is
+            // dropped, its weight counted in the bound, and the host says so.
+            dropped += refractedWaits ? transmittedWeight : reflectedWeight;
+            atomicAdd(counters[SNELL_COUNTER_OVERFLOW], 1u);
+            if (refractedWaits) {
+                r = reflectedRay;
+                hasRay = true;
+                return;
             }
-            [[unroll]] for (int k = 0; k < MAX_MEDIA; ++k)
-                if (uint(k) == count) media[k] = h.sphere;
-            count++;
-        } else if (removeAt < count) {
-            [[unroll]] for (int k = 0; k + 1 < MAX_MEDIA; ++k)
-                if (uint(k) >= removeAt && uint(k) + 1u < count) media[k] = media[k + 1];
+        } else if (!refractedWaits) {
+            pushRay(slot, pending, reflectedRay);  // with the parent's media, still current
+        }
+    }
+    // The refracted ray's medium stack replaces the parent's (kept when the
+    // reflected ray goes on with it).
+    uint parentMedia[MAX_MEDIA];
+    [[unroll]] for (int k = 0; k < MAX_MEDIA; ++k) parentMedia[k] = media[k];
+    uint count = r.mediaCount;
+    if (h.fromOutside) {
+        if (count == uint(MAX_MEDIA)) {  // deeper than the scene can nest: forget the outermost
+            [[unroll]] for (int k = 0; k + 1 < MAX_MEDIA; ++k) media[k] = media[k + 1];
             count--;
         }
-        r = Ray(h.point, refracted, transmittedWeight, r.depth + 1u, h.sphere, h.fromOutside, count, 0u);
-        hasRay = true;
+        [[unroll]] for (int k = 0; k < MAX_MEDIA; ++k)
+            if (uint(k) == count) media[k] = h.sphere;
+        count++;
+    } else if (removeAt < count) {
+        [[unroll]] for (int k = 0; k + 1 < MAX_MEDIA; ++k)
+            if (uint(k) >= removeAt && uint(k) + 1u < count) media[k] = media[k + 1];
+        count--;
+    }
+    r = Ray(h.point, refracted, transmittedWeight, r.depth + 1u, h.sphere, h.fromOutside, count, 0u);
+    hasRay = true;
+    if (refractedWaits && pending + 1u < RAY_STACK) {
+        pushRay(slot, pending, r);
+        [[unroll]] for (int k = 0; k < MAX_MEDIA; ++k) media[k] = parentMedia[k];
+        r = reflectedRay;
     }
 }
 
@@ -507,8 +578,19 @@ void main() {
 
     // This invocation's progress: its current pixel, that pixel's sum, and the
     // rays on its stack. Fresh, or resumed from the last dispatch.
-    SlotState state = SlotState(vec4(0.0), slot, 0u, 0u, 0u);
+    // Under a tolerance each pixel starts at the tolerance over the largest
+    // finite radiance bound (as CpuRenderer::renderPixel does).
+    float tolerance = frame.radiance.w;
+    float largestRadiance = 1.0;
+    [[unroll]] for (int c = 0; c < 3; ++c)
+        if (!isinf(frame.radiance[c])) largestRadiance = max(largestRadiance, frame.radiance[c]);
+    float firstCutOff = tolerance > 0.0 ? max(frame.ambient.w, tolerance / (4.0 * largestRadiance)) : frame.ambient.w;
+    SlotState state = SlotState(vec4(0.0), vec4(0.0, 0.0, 0.0, firstCutOff), vec4(0.0), vec4(INFINITY), slot, 0u, 0u,
+                                0u, 0u, 0u, 0u, 0u);
     if (tile.resume != 0u) state = slotStates[slot];
+    dropped = state.dropped.rgb;
+    cutOff = state.dropped.w;
+    uint deepest = 0u;
     bool done = state.pixel >= tilePixels;
     uvec2 pixel = uvec2(state.pixel % tile.width, state.pixel / tile.width);  // within the tile
     uint samples = frame.sampleCount;
@@ -519,6 +601,7 @@ void main() {
     Ray ray;
     bool hasRay = false;
     bool suspended = false;
+    uint passes = 0u;
     // With a loop budget every lane stays in this loop until the subgroup
     // leaves it together, so the subgroup operations below see all lanes.
     while (true) {
@@ -532,25 +615,50 @@ void main() {
             break;
         }
         tick(2u);  // this pass, and the closest-hit loop should no lane enter it
+        // Asked to stop (Ctrl-C, SIGTERM) while the dispatch runs: this
+        // invocation drops its work and the host discards the tile. Read every
+        // 256 passes, so even a pixel whose tree never ends is left promptly.
+        if (!done && (++passes & 255u) == 0u && atomicAdd(counters[SNELL_COUNTER_CANCEL], 0u) != 0u) {
+            done = true;
+            hasRay = false;
+            state.pending = 0u;
+            state.pixel = tilePixels;
+        }
         if (!done && !hasRay) {
             if (state.pending > 0u) {
                 ray = popRay(slot, state.pending);
                 hasRay = true;
             } else if (state.started == samples) {
-                // The pixel is finished: SPEC §3 mean, clamped on output. Next pixel.
-                outputPixels[state.pixel] = vec4(state.sum.rgb / float(samples), 1.0);
-                state.finished++;
-                slotStates[slot].finished = state.finished;
-                state.pixel += slots;
-                pixel += uvec2(tile.stepX, tile.stepY);
-                if (pixel.x >= tile.width) pixel += uvec2(-tile.width, 1u);
+                // The pixel is finished: SPEC §3 mean (clamped on output) and
+                // its truncation bound, negative where it is not finite.
+                bool unbounded;
+                float bound = addAttempt(state, dropped, float(samples), unbounded);
+                if (tolerance > 0.0 && bound > tolerance && cutOff > frame.ambient.w) {
+                    // Over the tolerance: the pixel again, with a 16x lower cut-off.
+                    cutOff = max(frame.ambient.w, cutOff / 16.0);
+                } else {
+                    outputPixels[state.pixel] = vec4(state.lower.rgb, unbounded ? -bound : bound);
+                    state.lower = vec4(0.0);
+                    state.upper = vec4(INFINITY);
+                    if (state.overBudget != 0u) atomicAdd(counters[SNELL_COUNTER_OVER_BUDGET], 1u);
+                    state.finished++;
+                    slotStates[slot].finished = state.finished;
+                    slotStates[slot].rays = state.rays + shadowRays;
+                    state.pixel += slots;
+                    pixel += uvec2(tile.stepX, tile.stepY);
+                    if (pixel.x >= tile.width) pixel += uvec2(-tile.width, 1u);
+                    cutOff = firstCutOff;
+                    done = state.pixel >= tilePixels;
+                }
                 state.started = 0u;
                 state.sum = vec4(0.0);
-                done = state.pixel >= tilePixels;
+                state.overBudget = 0u;
+                dropped = vec3(0.0);
             }
             if (!done && !hasRay) {
                 ray = cameraRay(pixel + uvec2(tile.originX, tile.originY), frame.firstSample + state.started);
                 state.started++;
+                state.treeRays = 0u;
                 hasRay = true;
                 if (COUNT_RAYS) countedRays[SNELL_COUNTER_PRIMARY]++;
             }
@@ -562,13 +670,25 @@ void main() {
         bool shading = false;
         if (hasRay) {
             weight = ray.weight;
-            if (AMPLIFYING) weight = mix(weight, vec3(0.0), greaterThanEqual(state.sum.rgb, vec3(saturation)));
-            if (worthTracing(weight)) {
+            // (A ray resuming its shading keeps the weight it started with.)
+            if (AMPLIFYING && ray.resumeShading == 0u)
+                weight = mix(weight, vec3(0.0), greaterThanEqual(state.sum.rgb, vec3(saturation)));
+            // A sample's tree past the budget: the rest of it is dropped.
+            bool overBudget = frame.treeBudget != 0u && state.treeRays >= frame.treeBudget && ray.resumeShading == 0u;
+            if (overBudget && worthTracing(weight)) state.overBudget = 1u;
+            if (worthTracing(weight) && !overBudget) {
+                if (ray.resumeShading == 0u) {
+                    state.treeRays++;
+                    state.rays++;
+                }
                 vec3 sum = state.sum.rgb;
                 shading = findHit(ray, weight, sum, h);
                 // The ambient part once, not again when shading resumes.
-                if (shading && ray.resumeShading == 0u) sum += weight * frame.ambient.rgb * h.kd.rgb;
+                if (shading && ray.resumeShading == 0u) sum += weighted(weight, frame.ambient.rgb * h.kd.rgb);
                 state.sum.rgb = sum;
+                deepest = max(deepest, ray.depth);
+            } else {
+                dropped += weight;
             }
             hasRay = shading;
         }
@@ -576,7 +696,7 @@ void main() {
         // (the same sums whether or not shading is suspended part-way).
         rvec3 v = -ray.dir;
         if (HAS_LIGHTS && LOOP_BUDGET == 0u && shading) {
-            for (uint j = 0u; j < frame.lightCount; ++j) state.sum.rgb += weight * shadeLight(j, h, v);
+            for (uint j = 0u; j < frame.lightCount; ++j) state.sum.rgb += weighted(weight, shadeLight(j, h, v));
         }
         if (HAS_LIGHTS && LOOP_BUDGET != 0u) {
             // Every lane runs this loop (it is not inside `if (shading)`), so the
@@ -589,11 +709,14 @@ void main() {
                 // At least one light a dispatch, whatever the hit cost: progress.
                 if (j > firstLight && subgroupAdd(loopTicks) >= LOOP_BUDGET) {
                     suspended = true;
-                    if (shading) ray.resumeShading = max(ray.resumeShading, j + 1u);  // the ray waits, to resume here
+                    if (shading) {
+                        ray.resumeShading = max(ray.resumeShading, j + 1u);  // the ray waits, to resume here
+                        ray.weight = weight;
+                    }
                     break;
                 }
                 tick(2u);  // this light, and the occlusion loop should no lane enter it
-                if (shading && j + 1u >= ray.resumeShading) state.sum.rgb += weight * shadeLight(j, h, v);
+                if (shading && j + 1u >= ray.resumeShading) state.sum.rgb += weighted(weight, shadeLight(j, h, v));
             }
             if (suspended) break;
         }
@@ -607,7 +730,10 @@ void main() {
     }
     // Under a loop budget the next dispatch resumes every invocation, those
     // whose subgroup finished included: each leaves its state, done or not.
+    state.dropped = vec4(dropped, cutOff);
+    state.rays += shadowRays;
     if (LOOP_BUDGET != 0u) slotStates[slot] = state;
+    if (deepest > 0u) atomicMax(counters[SNELL_COUNTER_DEEPEST], deepest);
     if (COUNT_RAYS) {
         [[unroll]] for (int k = 0; k < SNELL_RAY_COUNTER_COUNT; ++k)
             if (countedRays[k] != 0u) atomicAdd(counters[k], countedRays[k]);

@@ -112,6 +112,49 @@ SNELL_INJECT_FAULT=cosmic-ray "$SNELL" render "$SCENES/basic.scn" -o "$work/x.pn
 "$SNELL" render "$SCENES/basic.scn" --size 16 -o "$work/v.png" -v >"$work/out" 2>"$work/err" &&
   [ ! -s "$work/out" ] && grep -q "render .* ms (gpu-timestamps\|render .* ms (host" "$work/err" && ok || bad "-v: $(cat "$work/err")"
 
+# The truncation bound: in --stats, as an image, and --tolerance keeping it
+# within T on both back ends (scenes/mirrors.scn: ks 0.9 corridors).
+for backend in "" "--cpu"; do
+  "$SNELL" render "$SCENES/mirrors.scn" --size 24 -q $backend --tolerance 0.00196 --min-weight 1e-9 \
+    -o "$work/tol.pfm" --bound-image "$work/bound.pfm" --stats >"$work/stats" 2>"$work/err"; status=$?
+  [ $status -eq 0 ] && [ -s "$work/bound.pfm" ] && tail -n 1 "$work/stats" | python3 -c '
+import json, sys
+t = json.loads(sys.stdin.read())["truncation"]
+assert 0 <= t["max_bound"] <= 0.00196, t
+assert t["mean_bound"] <= t["max_bound"] and t["unbounded_pixels"] == 0 and t["deepest_ray"] >= 1, t
+' && ok || bad "--tolerance/--bound-image ${backend:-gpu} ($status): $(cat "$work/err")"
+done
+"$SNELL" render "$SCENES/mirrors.scn" --size 8 -q --tolerance -1 -o "$work/x.png" 2>"$work/err"; status=$?
+[ $status -eq 2 ] && ok || bad "--tolerance -1 gave $status (want 2)"
+
+# Renders split for a farm: --region windows joined by `snell assemble` are
+# the whole render bit for bit, on both back ends; bad windows and missing
+# pieces are errors (status 2) that write nothing.
+for backend in "" "--cpu"; do
+  "$SNELL" render "$SCENES/showcase.scn" --size 40 -q $backend -o "$work/whole.pfm" &&
+  "$SNELL" render "$SCENES/showcase.scn" --size 40 -q $backend --region 0 0 25 17 -o "$work/p1.pfm" &&
+  "$SNELL" render "$SCENES/showcase.scn" --size 40 -q $backend --region 25 0 40 17 -o "$work/p2.pfm" &&
+  "$SNELL" render "$SCENES/showcase.scn" --size 40 -q $backend --region 0 17 40 40 -o "$work/p3.pfm" &&
+  "$SNELL" assemble -s 40 -o "$work/joined.pfm" 0,0:"$work/p1.pfm" 25,0:"$work/p2.pfm" 0,17:"$work/p3.pfm" &&
+  cmp -s "$work/whole.pfm" "$work/joined.pfm" && ok || bad "--region + assemble not bit-identical (${backend:-gpu})"
+done
+"$SNELL" render "$SCENES/basic.scn" --size 16 -q --region 0 0 17 8 -o "$work/r.png" 2>"$work/err"; status=$?
+[ $status -eq 2 ] && [ ! -e "$work/r.png" ] && grep -q "is not a window" "$work/err" && ok || bad "--region outside the image ($status)"
+"$SNELL" assemble -s 40 -o "$work/j.png" 0,0:"$work/p1.pfm" 0,17:"$work/p3.pfm" 2>"$work/err"; status=$?
+[ $status -eq 2 ] && [ ! -e "$work/j.png" ] && grep -q "uncovered" "$work/err" && ok || bad "assemble with a missing piece ($status)"
+"$SNELL" assemble -o "$work/j.png" "$work/p1.pfm" 2>"$work/err"; status=$?
+[ $status -eq 2 ] && ok || bad "assemble piece without X,Y: ($status)"
+
+# Progress: on a terminal a bar with elapsed time, estimate and rays/s, erased
+# at the end; nothing of it when standard error is not a terminal.
+if command -v script >/dev/null; then
+  script -qfec "$SNELL render $SCENES/showcase.scn --size 200 --spp 2 -o $work/prog.png" "$work/tty" >/dev/null 2>&1
+  grep -q "elapsed" "$work/tty" && grep -q "Mrays/s" "$work/tty" && [ -s "$work/prog.png" ] && ok ||
+    bad "no progress bar on a terminal: $(tr '\r' '\n' <"$work/tty" | head -3)"
+fi
+"$SNELL" render "$SCENES/showcase.scn" --size 64 -o "$work/prog2.png" 2>"$work/err"
+! grep -q "elapsed" "$work/err" && ok || bad "progress written to a non-terminal"
+
 # -o - streams PPM to standard output (and --stats moves to standard error).
 "$SNELL" render "$SCENES/basic.scn" --size 16 -o - -q --stats >"$work/pipe.ppm" 2>"$work/err"; status=$?
 [ $status -eq 0 ] && [ "$(head -c 2 "$work/pipe.ppm")" = "P6" ] && [ "$(wc -c <"$work/pipe.ppm")" -eq $((13 + 16 * 16 * 3)) ] &&

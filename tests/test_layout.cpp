@@ -70,22 +70,23 @@ std::uint32_t skipOf(const gpu::BvhNode& n) { return std::bit_cast<std::uint32_t
 std::uint32_t codeOf(const gpu::BvhNode& n) { return std::bit_cast<std::uint32_t>(n.upper.w); }
 
 TEST(Layout, FrameParams) {
-    EXPECT_EQ(sizeof(gpu::FrameParams), 144u);
+    EXPECT_EQ(sizeof(gpu::FrameParams), 160u);
     EXPECT_EQ(offsetof(gpu::FrameParams, primaryStart), 0u);
     EXPECT_EQ(offsetof(gpu::FrameParams, cornerDir), 16u);
     EXPECT_EQ(offsetof(gpu::FrameParams, pixelRight), 32u);
     EXPECT_EQ(offsetof(gpu::FrameParams, pixelDown), 48u);
     EXPECT_EQ(offsetof(gpu::FrameParams, background), 64u);
     EXPECT_EQ(offsetof(gpu::FrameParams, ambient), 80u);
-    EXPECT_EQ(offsetof(gpu::FrameParams, imageWidth), 96u);
-    EXPECT_EQ(offsetof(gpu::FrameParams, imageHeight), 100u);
-    EXPECT_EQ(offsetof(gpu::FrameParams, supersample), 104u);
-    EXPECT_EQ(offsetof(gpu::FrameParams, maxDepth), 108u);
-    EXPECT_EQ(offsetof(gpu::FrameParams, sphereCount), 112u);
-    EXPECT_EQ(offsetof(gpu::FrameParams, lightCount), 116u);
-    EXPECT_EQ(offsetof(gpu::FrameParams, bvhNodeCount), 120u);
-    EXPECT_EQ(offsetof(gpu::FrameParams, firstSample), 124u);
-    EXPECT_EQ(offsetof(gpu::FrameParams, sampleCount), 128u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, radiance), 96u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, imageWidth), 112u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, imageHeight), 116u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, supersample), 120u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, maxDepth), 124u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, sphereCount), 128u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, lightCount), 132u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, bvhNodeCount), 136u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, firstSample), 140u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, sampleCount), 144u);
 }
 
 TEST(Layout, TileParams) {
@@ -100,9 +101,13 @@ TEST(Layout, TileParams) {
 }
 
 TEST(Layout, SlotStateAndPendingRay) {
-    EXPECT_EQ(sizeof(gpu::SlotState), 32u);
-    EXPECT_EQ(offsetof(gpu::SlotState, pixel), 16u);
-    EXPECT_EQ(offsetof(gpu::SlotState, finished), 28u);
+    EXPECT_EQ(sizeof(gpu::SlotState), 96u);
+    EXPECT_EQ(offsetof(gpu::SlotState, dropped), 16u);
+    EXPECT_EQ(offsetof(gpu::SlotState, lower), 32u);
+    EXPECT_EQ(offsetof(gpu::SlotState, upper), 48u);
+    EXPECT_EQ(offsetof(gpu::SlotState, pixel), 64u);
+    EXPECT_EQ(offsetof(gpu::SlotState, finished), 76u);
+    EXPECT_EQ(offsetof(gpu::SlotState, treeRays), 80u);
     EXPECT_EQ(sizeof(gpu::PendingRay), 64u);
     EXPECT_EQ(offsetof(gpu::PendingRay, weight), 32u);
     EXPECT_EQ(offsetof(gpu::PendingRay, depth), 48u);

@@ -288,7 +288,7 @@ TEST(CpuRenderer, DiffusePixelByHand) {
     ASSERT_EQ(image.height, 1);
     for (int k = 0; k < 3; ++k) EXPECT_NEAR(image.pixel(0, 0)[k], 0.5f, 1e-6f);
     snell::RayCounts counts;
-    const dvec3 c = renderer.renderPixel(req, 0, 0, counts);
+    const dvec3 c = renderer.renderPixel(req, 0, 0, counts).colour;
     expectNear(c, dvec3(0.5), 1e-12);
     EXPECT_EQ(counts.primary, 1u);
     EXPECT_EQ(counts.shadow, 1u);

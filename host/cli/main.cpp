@@ -44,7 +44,6 @@ double msSince(Clock::time_point start) {
 
 constexpr int kExitRuntime = 1;
 constexpr int kExitInput = 2;
-constexpr int kMaxGpuDepth = 256;
 
 // A termination signal asks the render to stop; the temporary output is
 // removed and the status is the shell's convention for death by that signal.
@@ -87,6 +86,10 @@ struct RenderOptions {
     std::optional<int> size;
     std::optional<int> depth;
     std::optional<double> minWeight;
+    std::optional<double> tolerance;
+    std::optional<std::uint64_t> treeBudget;
+    std::string boundImage;
+    std::vector<int> region;  // X0 Y0 X1 Y1, or empty
     std::optional<int> supersample;
     int gpu = -1;
     std::string precision = "fp32";
@@ -98,32 +101,95 @@ struct RenderOptions {
     std::uint32_t loopBudget = 0;     // $SNELL_LOOP_BUDGET, for tests
 };
 
-// A progress line on stderr, only when stderr is a terminal.
+// A progress bar on stderr, only when stderr is a terminal: the pixels
+// finished, the time so far, an estimate of the time left and the rays a
+// second, a few times a second; erased when the render ends.
 class Progress {
 public:
-    explicit Progress(bool enabled) : enabled_(enabled && ::isatty(STDERR_FILENO)) {}
-    std::function<void(double)> callback() {
+    explicit Progress(bool enabled) : enabled_(enabled && ::isatty(STDERR_FILENO)), start_(Clock::now()) {}
+    std::function<void(double, std::uint64_t)> callback() {
         if (!enabled_) return {};
-        return [this](double fraction) {
+        return [this](double fraction, std::uint64_t rays) {
             std::lock_guard<std::mutex> lock(mutex_);
+            if (!enabled_) return;
             const auto now = Clock::now();
-            if (fraction < 1.0 && now - last_ < std::chrono::milliseconds(100)) return;
+            if (fraction < 1.0 && now - last_ < std::chrono::milliseconds(250)) return;
             last_ = now;
             shown_ = true;
-            std::fprintf(stderr, "\rsnell: rendering %5.1f%%", 100.0 * fraction);
+            const double elapsed = std::chrono::duration<double>(now - start_).count();
+            constexpr int kWidth = 24;
+            const int filled = std::clamp(int(fraction * kWidth + 0.5), 0, kWidth);
+            std::string line = "\rsnell: [" + std::string(filled, '#') + std::string(kWidth - filled, '.') + "] ";
+            char text[160];
+            std::snprintf(text, sizeof text, "%5.1f%%  %s elapsed", 100.0 * fraction, duration(elapsed).c_str());
+            line += text;
+            if (fraction > 0.01 && fraction < 1.0)
+                line += ", ~" + duration(elapsed * (1.0 - fraction) / fraction) + " left";
+            if (rays > 0 && elapsed > 0.0) {
+                std::snprintf(text, sizeof text, ", %.3g Mrays/s", double(rays) / elapsed * 1e-6);
+                line += text;
+            }
+            width_ = std::max(width_, line.size());
+            std::fprintf(stderr, "%-*s", int(width_), line.c_str());
             std::fflush(stderr);
         };
     }
-    ~Progress() {
-        if (shown_) std::fprintf(stderr, "\r%*s\r", 40, "");
+    // Erases the bar (before any message that follows the render).
+    void done() {
+        std::lock_guard<std::mutex> lock(mutex_);
+        if (shown_) std::fprintf(stderr, "\r%*s\r", int(width_), "");
+        shown_ = false;
+        enabled_ = false;
     }
+    ~Progress() { done(); }
 
 private:
+    static std::string duration(double seconds) {
+        char text[32];
+        if (seconds < 60.0) std::snprintf(text, sizeof text, "%.1f s", seconds);
+        else if (seconds < 3600.0) std::snprintf(text, sizeof text, "%d min %02d s", int(seconds / 60), int(seconds) % 60);
+        else std::snprintf(text, sizeof text, "%d h %02d min", int(seconds / 3600), int(seconds / 60) % 60);
+        return text;
+    }
     bool enabled_;
     bool shown_ = false;
+    std::size_t width_ = 0;
     std::mutex mutex_;
+    Clock::time_point start_;
     Clock::time_point last_{};
 };
+
+// Where the render may still differ from the exact image (SPEC §4 limit):
+// pixels whose dropped light has no finite bound, or whose tree was stopped.
+void reportTruncation(const snell::TruncationReport& t, const snell::TraceSettings& settings) {
+    auto examples = [](const std::vector<std::array<int, 2>>& pixels, std::uint64_t count) {
+        std::string s;
+        for (const auto& p : pixels) s += (s.empty() ? "" : ", ") + ("(" + std::to_string(p[0]) + ", " + std::to_string(p[1]) + ")");
+        if (count > pixels.size()) s += ", ...";
+        return s;
+    };
+    if (t.unbounded > 0)
+        std::cerr << "snell: warning: " << t.unbounded << " pixel(s) dropped light of a material with ks + kt >= 1, "
+                  << "which need not decay: their bound is only the clamp to 1 (--bound-image shows it), e.g. "
+                  << examples(t.unboundedExamples, t.unbounded) << "\n";
+    if (t.overBudget > 0)
+        std::cerr << "snell: warning: " << t.overBudget << " pixel(s) reached the tree budget of "
+                  << settings.treeBudget << " rays a sample and were stopped (their bound says by how much they "
+                  << "may still move), e.g. " << examples(t.overBudgetExamples, t.overBudget) << "\n";
+    if (t.overTolerance > t.unbounded)
+        std::cerr << "snell: warning: " << t.overTolerance << " pixel(s) are above the tolerance "
+                  << settings.tolerance << " at the floor cut-off " << settings.minWeight
+                  << " (largest bound " << t.maxBound << ")\n";
+}
+
+std::string truncationJson(const snell::TruncationReport& t) {
+    std::ostringstream j;
+    j.precision(6);
+    j << "{\"max_bound\": " << t.maxBound << ", \"mean_bound\": " << t.meanBound()
+      << ", \"unbounded_pixels\": " << t.unbounded << ", \"over_budget_pixels\": " << t.overBudget
+      << ", \"over_tolerance_pixels\": " << t.overTolerance << ", \"deepest_ray\": " << t.deepest << "}";
+    return j.str();
+}
 
 // Compiled pipelines persist here between runs: $SNELL_CACHE_DIR, else
 // $XDG_CACHE_HOME/snell, else ~/.cache/snell; empty (no cache) if none is set.
@@ -165,6 +231,23 @@ int runRender(const RenderOptions& o) {
     request.trace = o.cpu ? snell::kReferenceSettings : snell::kDefaultSettings;
     if (o.depth) request.trace.maxDepth = *o.depth;
     if (o.minWeight) request.trace.minWeight = *o.minWeight;
+    if (o.tolerance) request.trace.tolerance = *o.tolerance;
+    if (o.treeBudget) request.trace.treeBudget = *o.treeBudget;
+    snell::TruncationReport truncation;
+    request.truncation = &truncation;
+    std::vector<float> boundImage;
+    if (!o.boundImage.empty()) request.boundImage = &boundImage;
+    if (!o.region.empty()) {
+        const snell::PixelWindow w{o.region[0], o.region[1], o.region[2], o.region[3]};
+        if (w.x0 < 0 || w.y0 < 0 || w.x1 > size || w.y1 > size || w.empty()) {
+            std::cerr << "snell: error: --region " << w.x0 << " " << w.y0 << " " << w.x1 << " " << w.y1
+                      << " is not a window of the " << size << "x" << size
+                      << " image (want 0 <= X0 < X1 <= " << size << ", 0 <= Y0 < Y1 <= " << size << ")\n";
+            return kExitInput;
+        }
+        request.window = w;
+    }
+    const snell::PixelWindow area = request.area();
     request.cancel = &gInterrupted;
     Progress progress(!o.quiet);
     request.progress = progress.callback();
@@ -178,11 +261,15 @@ int runRender(const RenderOptions& o) {
             "size " + std::to_string(size) + ", supersample " + std::to_string(request.supersample) + ", depth " +
             std::to_string(request.trace.maxDepth) + ", min-weight " + std::to_string(request.trace.minWeight) +
             ", " + (o.cpu ? "CPU reference" : "GPU " + o.precision);
-        writer = snell::ImageWriter::open(output, size, size,
-                                          {{"Title", scene.name},
-                                           {"Source", o.scene},
-                                           {"Software", std::string("snell ") + SNELL_VERSION},
-                                           {"Comment", settings}});
+        snell::ImageText text{{"Title", scene.name},
+                              {"Source", o.scene},
+                              {"Software", std::string("snell ") + SNELL_VERSION},
+                              {"Comment", settings}};
+        // A piece of a larger image says where it goes (`snell assemble`).
+        if (!o.region.empty())
+            text.push_back({"Region", std::to_string(area.x0) + " " + std::to_string(area.y0) + " of " +
+                                          std::to_string(size) + "x" + std::to_string(size)});
+        writer = snell::ImageWriter::open(output, area.width(), area.height(), text);
     } catch (const snell::ImageIOError& e) {
         std::cerr << "snell: error: " << e.what() << "\n";
         return kExitRuntime;
@@ -212,11 +299,6 @@ int runRender(const RenderOptions& o) {
         device = "CPU reference (double, " + std::to_string(std::max(1u, std::thread::hardware_concurrency())) + " threads)";
         timing = "host";
     } else {
-        if (request.trace.maxDepth > kMaxGpuDepth) {
-            std::cerr << "snell: error: --depth " << request.trace.maxDepth << " exceeds the GPU limit of "
-                      << kMaxGpuDepth << " (use --cpu for deeper trees)\n";
-            return kExitInput;
-        }
         try {
             snell::vk::ContextOptions options;
             options.deviceIndex = o.gpu;
@@ -237,6 +319,10 @@ int runRender(const RenderOptions& o) {
             readbackMs = r.readbackMs;
             tiles = r.tiles;
             dispatches = r.dispatches;
+            if (r.stackOverflows > 0 && !o.quiet)
+                std::cerr << "snell: warning: " << r.stackOverflows << " ray(s) found their invocation's ray stack ("
+                          << r.rayStack << " entries) full and were dropped (an amplifying tree); the truncation "
+                          << "bound includes them. A higher --min-weight or a lower --depth keeps the tree smaller\n";
             timing = r.gpuTimed ? "gpu-timestamps" : "host";
             if (o.validation && context.validationMessages() > 0) {
                 std::cerr << "snell: error: the Vulkan validation layer reported " << context.validationMessages()
@@ -244,16 +330,18 @@ int runRender(const RenderOptions& o) {
                 return kExitRuntime;
             }
         } catch (const snell::vk::VulkanError& e) {
+            progress.done();
             if (gInterrupted.load()) {
-                std::cerr << "\nsnell: interrupted; no image written\n";
+                std::cerr << "snell: interrupted; no image written\n";
                 return interruptedStatus();
             }
             std::cerr << "snell: error: " << e.what() << "\n";
             return kExitRuntime;
         }
     }
+    progress.done();
     if (gInterrupted.load()) {
-        std::cerr << "\nsnell: interrupted; no image written\n";
+        std::cerr << "snell: interrupted; no image written\n";
         return interruptedStatus();
     }
     if (!writeError.empty()) {
@@ -268,6 +356,19 @@ int runRender(const RenderOptions& o) {
         return kExitRuntime;
     }
     writeMs += msSince(commitStart);
+    if (!o.boundImage.empty()) {
+        // The bound as a grey image: float formats keep it as is.
+        snell::Image bound(area.width(), area.height());
+        for (std::size_t i = 0; i < boundImage.size(); ++i)
+            bound.rgb[3 * i] = bound.rgb[3 * i + 1] = bound.rgb[3 * i + 2] = boundImage[i];
+        try {
+            snell::writeImage(o.boundImage, bound);
+        } catch (const snell::ImageIOError& e) {
+            std::cerr << "snell: error: " << e.what() << "\n";
+            return kExitRuntime;
+        }
+    }
+    if (!o.quiet) reportTruncation(truncation, request.trace);
     if (o.verbose) {
         std::fprintf(stderr,
                      "snell: %s: %dx%d, %s on %s\n"
@@ -296,8 +397,79 @@ int runRender(const RenderOptions& o) {
           << ", \"readback_ms\": " << readbackMs << ", \"write_ms\": " << writeMs
           << ", \"total_ms\": " << msSince(totalStart) << ", \"rays\": {\"primary\": " << rays.primary
           << ", \"shadow\": " << rays.shadow << ", \"reflected\": " << rays.reflected
-          << ", \"refracted\": " << rays.refracted << ", \"total\": " << rays.total() << "}}";
+          << ", \"refracted\": " << rays.refracted << ", \"total\": " << rays.total() << "}"
+          << ", \"tolerance\": " << request.trace.tolerance << ", \"truncation\": " << truncationJson(truncation)
+          << "}";
         statsOut << j.str() << std::endl;
+    }
+    return 0;
+}
+
+// `snell assemble`: pieces rendered with --region, each given as X,Y:FILE (its
+// top-left pixel in the whole image), into one image; every pixel must be
+// covered. The pieces are pixels of the same render, so the result is the
+// whole render, bit for bit.
+int runAssemble(const std::string& output, const std::vector<std::string>& pieces, int size) {
+    struct Piece {
+        int x = 0, y = 0;
+        snell::Image image;
+    };
+    std::vector<Piece> parsed;
+    int width = 0, height = 0;
+    for (const std::string& arg : pieces) {
+        Piece p;
+        const auto colon = arg.find(':');
+        const auto comma = arg.find(',');
+        char* end = nullptr;
+        bool ok = colon != std::string::npos && comma != std::string::npos && comma < colon;
+        if (ok) {
+            p.x = int(std::strtol(arg.c_str(), &end, 10));
+            ok = end == arg.c_str() + comma;
+        }
+        if (ok) {
+            p.y = int(std::strtol(arg.c_str() + comma + 1, &end, 10));
+            ok = end == arg.c_str() + colon && p.x >= 0 && p.y >= 0;
+        }
+        if (!ok) {
+            std::cerr << "snell: error: a piece is X,Y:FILE (its top-left pixel, then the file), got '" << arg << "'\n";
+            return kExitInput;
+        }
+        try {
+            p.image = snell::readImage(arg.substr(colon + 1));
+        } catch (const std::exception& e) {
+            std::cerr << "snell: error: " << e.what() << "\n";
+            return kExitRuntime;
+        }
+        width = std::max(width, p.x + p.image.width);
+        height = std::max(height, p.y + p.image.height);
+        parsed.push_back(std::move(p));
+    }
+    if (size > 0) {
+        if (width > size || height > size) {
+            std::cerr << "snell: error: the pieces reach " << width << "x" << height << ", beyond --size " << size << "\n";
+            return kExitInput;
+        }
+        width = height = size;
+    }
+    snell::Image whole(width, height);
+    std::vector<char> covered(std::size_t(width) * height, 0);
+    for (const Piece& p : parsed) {
+        for (int y = 0; y < p.image.height; ++y) {
+            std::copy_n(p.image.pixel(0, y), std::size_t(p.image.width) * 3, whole.pixel(p.x, p.y + y));
+            std::fill_n(covered.begin() + std::size_t(p.y + y) * width + p.x, p.image.width, 1);
+        }
+    }
+    const auto missing = std::count(covered.begin(), covered.end(), 0);
+    if (missing > 0) {
+        std::cerr << "snell: error: the pieces leave " << missing << " of the " << width << "x" << height
+                  << " pixels uncovered; nothing written\n";
+        return kExitInput;
+    }
+    try {
+        snell::writeImage(output, whole, {{"Software", std::string("snell ") + SNELL_VERSION + " assemble"}});
+    } catch (const snell::ImageIOError& e) {
+        std::cerr << "snell: error: " << e.what() << "\n";
+        return kExitRuntime;
     }
     return 0;
 }
@@ -423,10 +595,25 @@ int main(int argc, char** argv) {
     render->add_flag("--cpu", ro.cpu, "Render with the double-precision CPU reference instead of the GPU");
     render->add_option("-s,--size", ro.size, "Image size in pixels (overrides the scene's view n)")
         ->check(CLI::Range(1, snell::ParseLimits::kMaxImageSize));
-    render->add_option("-d,--depth", ro.depth, "Maximum reflection/refraction depth (default: 64)")
+    render->add_option("-d,--depth", ro.depth, "Maximum reflection/refraction depth (default: 10000, a safety cap: the tolerance decides)")
         ->check(CLI::Range(0, 100000));
-    render->add_option("--min-weight", ro.minWeight, "Stop rays whose weight falls below W; 0 disables (default: GPU 1e-4, CPU 1e-7)")
+    render->add_option("--min-weight", ro.minWeight, "Stop rays whose weight falls below W; with a tolerance, the lowest cut-off tried (default: GPU 1e-5, CPU 1e-7)")
         ->check(kFinite)->check(CLI::Range(0.0, 1.0));
+    render->add_option("--tolerance", ro.tolerance,
+                       "Trace each pixel until what its cut-offs may have lost is at most T; 0: a fixed cut-off "
+                       "(default: GPU 0.5/255 = 0.00196, exact in 8 bits; CPU 0.01/255)")
+        ->check(kFinite)->check(CLI::Range(0.0, 1.0));
+    render->add_option("--tree-budget", ro.treeBudget,
+                       "Stop a sample's ray tree after N rays and report its pixel (default: 65536)")
+        ->check(CLI::PositiveNumber);
+    render->add_option("--bound-image", ro.boundImage,
+                       "Also write each pixel's truncation bound (how far it may be from the exact image) to FILE "
+                       "(.pfm or .exr keep it unclamped)")
+        ->check(kImageFormat);
+    render->add_option("--region", ro.region,
+                       "Render only pixels X0..X1-1, Y0..Y1-1 of the image, as an image of that window (for a "
+                       "render farm: join the pieces with 'snell assemble')")
+        ->expected(4)->check(CLI::NonNegativeNumber);
     render->add_option("--spp,--supersample", ro.supersample, "Rays per pixel per axis (overrides the scene's supersample)")
         ->check(CLI::Range(1, snell::ParseLimits::kMaxSupersample));
     render->add_option("--gpu", ro.gpu, "Vulkan device index (see 'snell devices'; default: $SNELL_GPU, else the best)")
@@ -488,6 +675,17 @@ int main(int argc, char** argv) {
 
     std::string compareA, compareB, compareDiff;
     int compareThreshold = 3;
+    std::string assembleOutput;
+    std::vector<std::string> assemblePieces;
+    int assembleSize = 0;
+    CLI::App* assemble = app.add_subcommand("assemble", "Join pieces rendered with render --region into one image");
+    assemble->add_option("-o,--output", assembleOutput, "The whole image (.png, .ppm, .pfm or .exr)")
+        ->required()->check(kImageFormat);
+    assemble->add_option("pieces", assemblePieces, "Each piece as X,Y:FILE, X and Y its top-left pixel (X0 and Y0 "
+                                                   "of its --region)")->required();
+    assemble->add_option("-s,--size", assembleSize, "The whole image's size, so a missing piece is an error "
+                                                    "(default: the extent of the pieces)")
+        ->check(CLI::Range(1, snell::ParseLimits::kMaxImageSize));
     CLI::App* compare = app.add_subcommand("compare", "Error metrics of image A against reference B (8-bit units): text, or --json");
     compare->add_option("a", compareA, "Test image")->required();
     compare->add_option("b", compareB, "Reference image")->required();
@@ -544,6 +742,7 @@ int main(int argc, char** argv) {
         return runPreviewCommand(po);
     }
     if (app.got_subcommand("devices")) return runDevices();
+    if (assemble->parsed()) return runAssemble(assembleOutput, assemblePieces, assembleSize);
     if (compare->parsed()) return runCompare(compareA, compareB, compareDiff, compareThreshold, compareJson);
     std::cout << app.help();
     return 0;

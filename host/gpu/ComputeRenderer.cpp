@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <functional>
 #include <thread>
 
 #include "gpu/DriverProbe.h"
@@ -143,6 +145,36 @@ void ComputeRenderer::destroyBuffers() {
     for (vk::Buffer& b : sceneBuffers_) context_.destroy(b);
 }
 
+namespace {
+
+// How many rays may wait on an invocation's stack (trace.comp, spawnChildren).
+// A ray waits only where a hit both reflects and refracts, and then the
+// lighter child goes on: below k waiting rays the path's weight is at most
+// q^k, q the largest gain of a lighter child (min(max ks, max kt) over the
+// materials), times gains of at most g = max(ks + kt) elsewhere. Where g <= 1
+// and q < 1 the weight must stay above the cut-off floor w, so k <= log w /
+// log q: 14 for the default 1e-4 and glass of ks 0.5, however deep the tree,
+// and a chain of reflections needs none. Otherwise (amplifying materials, no
+// cut-off) the depth limit bounds k, up to kMaxRayStack; past that the
+// shader drops the heavier child and counts it (SNELL_COUNTER_OVERFLOW).
+constexpr std::uint32_t kMaxRayStack = 256;
+std::uint32_t rayStackEntries(const Scene& scene, const TraceSettings& trace, bool reflection) {
+    if (!reflection) return 0;
+    double lighter = 0.0, gain = 0.0;
+    for (const Material& m : scene.materials) {
+        const double ks = std::max({m.ks.x, m.ks.y, m.ks.z}), kt = std::max({m.kt.x, m.kt.y, m.kt.z});
+        if (ks > 0.0 && kt > 0.0) lighter = std::max(lighter, std::min(ks, kt));
+        gain = std::max({gain, m.ks.x + m.kt.x, m.ks.y + m.kt.y, m.ks.z + m.kt.z});
+    }
+    const auto depthBound = static_cast<std::uint32_t>(std::clamp(trace.maxDepth, 0, int(kMaxRayStack)));
+    if (lighter == 0.0) return 0;
+    if (gain > 1.0 || lighter >= 1.0 || trace.minWeight <= 0.0) return depthBound;
+    const double k = std::floor(std::log(trace.minWeight) / std::log(lighter)) + 1.0;  // + 1: float rounding
+    return std::min(depthBound, static_cast<std::uint32_t>(std::min(k, double(kMaxRayStack))));
+}
+
+}  // namespace
+
 ComputeRenderer::Specialisation ComputeRenderer::specialise(const RenderRequest& request, bool countRays) const {
     // Specialise to the scene: only what it uses is compiled.
     const bool hasRefraction = layout_.refractiveSpheres > 0 && request.trace.refraction;
@@ -164,10 +196,10 @@ ComputeRenderer::Specialisation ComputeRenderer::specialise(const RenderRequest&
     values[SNELL_SPEC_COUNT_RAYS] = countRays;
     values[SNELL_SPEC_MAX_MEDIA] = static_cast<std::uint32_t>(
         std::clamp<std::size_t>(layout_.refractiveSpheres, 1, SNELL_MAX_MEDIA_LIMIT));
-    // Depth-first with two children per ray: at most maxDepth deferred
-    // reflections and the suspended ray wait. Without refraction a ray has at
-    // most one child, traced at once: only a suspended ray ever waits.
-    values[SNELL_SPEC_RAY_STACK] = static_cast<std::uint32_t>(hasRefraction ? request.trace.maxDepth + 1 : 1);
+    // Without refraction a ray has at most one child, traced at once: only a
+    // suspended ray ever waits. With it, see rayStackEntries.
+    values[SNELL_SPEC_RAY_STACK] =
+        hasRefraction ? rayStackEntries(scene_, request.trace, hasReflection) + 1 : 1;  // + the suspended ray
     values[SNELL_SPEC_AMPLIFYING] = layout_.amplifying;
     values[SNELL_SPEC_LOOP_BUDGET] = loopBudget_;
     return values;
@@ -299,7 +331,11 @@ constexpr unsigned kCpuWorkgroupsPerCore = 8;
 
 GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool countRays) {
     GpuRenderResult result;
-    if (!request.rowSink) result.image = Image(request.width, request.height);
+    // The window rendered (the whole image unless asked); pixel coordinates
+    // stay those of the whole image, so each pixel is the same either way.
+    const PixelWindow area = request.area();
+    const int areaWidth = area.width(), areaHeight = area.height();
+    if (!request.rowSink) result.image = Image(areaWidth, areaHeight);
     VkDevice device = context_.device();
     try {
         const auto pipelineStart = Clock::now();
@@ -308,8 +344,8 @@ GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool count
         // Tiles: square, at most kMaxTileSide (16 MiB of float image).
         const int s = std::max(1, request.supersample);
         const bool wide = layout_.precision == gpu::Precision::Fp64;  // a low part per pending ray too
-        const int tileW = std::min(kMaxTileSide, request.width);
-        const int tileH = std::min(kMaxTileSide, request.height);
+        const int tileW = std::min(kMaxTileSide, areaWidth);
+        const int tileH = std::min(kMaxTileSide, areaHeight);
         // Persistent invocations (trace.comp): on a CPU device a few workgroups
         // per core keep every core busy to the end of the dispatch; on a GPU
         // one per pixel, as many as the memory for their ray stacks allows.
@@ -340,7 +376,8 @@ GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool count
         gpu::FrameParams frameLow{};
         const gpu::FrameParams frame = gpu::makeFrameParams(
             scene_, layout_, request.camera, request.width, request.height, s, request.firstSample,
-            request.sampleCount, request.trace.maxDepth, request.trace.minWeight, &frameLow);
+            request.sampleCount, request.trace.maxDepth, request.trace.minWeight, request.trace.tolerance,
+            request.trace.treeBudget, &frameLow);
         context_.destroy(p.frame);
         context_.destroy(p.frameLow);
         p.frame = context_.createBufferWithData(&frame, sizeof frame, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
@@ -393,6 +430,9 @@ GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool count
 
         // Record, submit and wait for one command buffer.
         double hostRenderMs = 0.0, gpuRenderMs = 0.0;
+        // While a dispatch runs the host wakes a few times a second for this:
+        // progress read from the invocations' states, and Ctrl-C.
+        std::function<void()> whileRunning;
         // `setup` is recorded before the timed part, `record`.
         auto submit = [&](auto setup, auto record, bool timed) {
             VkCommandBuffer cmd = p.commands;
@@ -413,7 +453,16 @@ GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool count
             info.commandBufferCount = 1;
             info.pCommandBuffers = &cmd;
             check(context_.submit(info, p.fence), "vkQueueSubmit");
-            check(vkWaitForFences(device, 1, &p.fence, VK_TRUE, UINT64_MAX), "vkWaitForFences");
+            for (;;) {
+                constexpr std::uint64_t kPollNs = 100'000'000;
+                const VkResult waited =
+                    vkWaitForFences(device, 1, &p.fence, VK_TRUE, whileRunning ? kPollNs : UINT64_MAX);
+                if (waited != VK_TIMEOUT) {
+                    check(waited, "vkWaitForFences");
+                    break;
+                }
+                whileRunning();
+            }
             check(vkResetFences(device, 1, &p.fence), "vkResetFences");
             if (timed) {
                 hostRenderMs += msSince(start);
@@ -441,24 +490,45 @@ GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool count
         }
         result.pipelineMs = msSince(pipelineStart);
 
+        TruncationReport truncation;
+        if (request.boundImage) request.boundImage->assign(std::size_t(areaWidth) * areaHeight, 0.0f);
         // Streaming rows: one band of tile rows at a time.
-        Image band = request.rowSink ? Image(request.width, tileH) : Image();
-        const int tilesX = (request.width + tileW - 1) / tileW;
-        const int tilesY = (request.height + tileH - 1) / tileH;
+        Image band = request.rowSink ? Image(areaWidth, tileH) : Image();
+        const int tilesX = (areaWidth + tileW - 1) / tileW;
+        const int tilesY = (areaHeight + tileH - 1) / tileH;
         const int tileCount = tilesX * tilesY;
         auto* counters = static_cast<std::uint32_t*>(p.counters.mapped);
+        // Rays traced in the tiles already finished; the tile in progress adds
+        // its invocations' counts (SlotState::rays).
+        std::uint64_t raysBefore = 0;
+        const auto* states = static_cast<const gpu::SlotState*>(p.slotStates.mapped);
+        auto reportProgress = [&](const gpu::TileParams& tile, bool final) {
+            std::uint64_t finished = 0, rays = raysBefore;
+            for (VkDeviceSize k = 0; k < slots; ++k) {
+                finished += states[k].finished;
+                rays += states[k].rays;
+            }
+            if (request.progress)
+                request.progress((result.tiles + double(finished) / double(tile.width * tile.height)) / tileCount, rays);
+            if (final) raysBefore = rays;
+        };
         for (int ty = 0; ty < tilesY; ++ty) {
             for (int tx = 0; tx < tilesX; ++tx) {
                 gpu::TileParams tile{};
-                tile.originX = std::uint32_t(tx * tileW);
-                tile.originY = std::uint32_t(ty * tileH);
-                tile.width = std::uint32_t(std::min(tileW, request.width - tx * tileW));
-                tile.height = std::uint32_t(std::min(tileH, request.height - ty * tileH));
+                tile.originX = std::uint32_t(area.x0 + tx * tileW);
+                tile.originY = std::uint32_t(area.y0 + ty * tileH);
+                tile.width = std::uint32_t(std::min(tileW, areaWidth - tx * tileW));
+                tile.height = std::uint32_t(std::min(tileH, areaHeight - ty * tileH));
                 tile.stepX = std::uint32_t(slots % tile.width);
                 tile.stepY = std::uint32_t(slots / tile.width);
                 const std::uint32_t groups = std::uint32_t(slots / SNELL_WORKGROUP_SIZE);
                 // One dispatch renders the tile; where the driver limits loops,
                 // the invocations suspend and the next dispatch resumes them.
+                whileRunning = [&] {
+                    if (request.cancel && request.cancel->load())
+                        std::atomic_ref<std::uint32_t>(counters[SNELL_COUNTER_CANCEL]).store(1u);
+                    reportProgress(tile, false);
+                };
                 for (int pass = 0;; ++pass) {
                     if (request.cancel && request.cancel->load()) throw vk::VulkanError("render cancelled");
                     std::memset(counters, 0, SNELL_COUNTER_COUNT * sizeof(std::uint32_t));
@@ -484,6 +554,9 @@ GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool count
                         throw vk::VulkanError("a single ray needed more loop iterations than lavapipe allows in one "
                                               "dispatch (65535 per SIMD row); the image would be wrong. Try fewer "
                                               "lights or a smaller --depth");
+                    truncation.deepest = std::max(truncation.deepest, int(counters[SNELL_COUNTER_DEEPEST]));
+                    result.stackOverflows += counters[SNELL_COUNTER_OVERFLOW];
+                    truncation.overBudget += counters[SNELL_COUNTER_OVER_BUDGET];
                     if (countRays) {
                         result.rays.primary += counters[SNELL_COUNTER_PRIMARY];
                         result.rays.shadow += counters[SNELL_COUNTER_SHADOW];
@@ -491,33 +564,40 @@ GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool count
                         result.rays.refracted += counters[SNELL_COUNTER_REFRACTED];
                     }
                     const std::uint32_t unfinished = counters[SNELL_COUNTER_UNFINISHED];
-                    if (request.progress) {
-                        std::uint64_t finished = 0;
-                        const auto* states = static_cast<const gpu::SlotState*>(p.slotStates.mapped);
-                        for (VkDeviceSize k = 0; k < slots; ++k) finished += states[k].finished;
-                        request.progress((result.tiles + double(finished) / double(tile.width * tile.height)) /
-                                         tileCount);
+                    if (request.cancel && request.cancel->load()) throw vk::VulkanError("render cancelled");
+                    if (unfinished == 0) {
+                        reportProgress(tile, true);
+                        break;
                     }
-                    if (unfinished == 0) break;
+                    reportProgress(tile, false);
                 }
                 // The finished tile, from where the shader wrote it.
                 const auto readStart = Clock::now();
                 const auto* texels = static_cast<const float*>(p.output.mapped);
                 for (std::uint32_t y = 0; y < tile.height; ++y) {
-                    float* row = request.rowSink ? band.pixel(tile.originX, y)
-                                                 : result.image.pixel(tile.originX, tile.originY + y);
+                    const int column = int(tile.originX) - area.x0, windowRow = int(tile.originY + y) - area.y0;
+                    float* row = request.rowSink ? band.pixel(column, y) : result.image.pixel(column, windowRow);
                     const float* src = texels + std::size_t(y) * tile.width * 4;
+                    const int imageY = int(tile.originY + y);
                     for (std::uint32_t x = 0; x < tile.width; ++x) {
                         row[x * 3 + 0] = src[x * 4 + 0];
                         row[x * 3 + 1] = src[x * 4 + 1];
                         row[x * 3 + 2] = src[x * 4 + 2];
+                        // The pixel's truncation bound, negative where not finite.
+                        const float bound = std::abs(src[x * 4 + 3]);
+                        const int imageX = int(tile.originX + x);
+                        truncation.addPixel(imageX, imageY, bound, src[x * 4 + 3] < 0.0f, false);
+                        if (request.boundImage)
+                            (*request.boundImage)[std::size_t(windowRow) * areaWidth + column + x] = bound;
                     }
                 }
                 result.readbackMs += msSince(readStart);
                 ++result.tiles;
             }
-            if (request.rowSink) request.rowSink(band.rgb.data(), std::min(tileH, request.height - ty * tileH));
+            if (request.rowSink) request.rowSink(band.rgb.data(), std::min(tileH, areaHeight - ty * tileH));
         }
+        if (request.truncation) *request.truncation = truncation;
+        result.rayStack = values[SNELL_SPEC_RAY_STACK];
         result.gpuTimed = p.queries != VK_NULL_HANDLE;
         result.renderMs = result.gpuTimed ? gpuRenderMs : hostRenderMs;
     } catch (...) {

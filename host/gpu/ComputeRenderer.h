@@ -24,6 +24,8 @@ struct GpuRenderResult {
     int tiles = 0;
     int dispatches = 0;       // more than one a tile where the driver limits loops (shared_layout.h)
     int invocations = 0;      // persistent invocations a dispatch (trace.comp)
+    std::uint32_t rayStack = 0;        // entries of each invocation's ray stack
+    std::uint64_t stackOverflows = 0;  // rays dropped on a full stack (their weight is in the bound)
 };
 
 class ComputeRenderer {

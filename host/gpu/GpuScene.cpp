@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "bvh/Bvh.h"
+#include "render/Truncation.h"
 
 namespace snell::gpu {
 namespace {
@@ -173,7 +174,8 @@ GpuScene buildGpuScene(const snell::Scene& scene, const snell::Camera& camera, P
 
 FrameParams makeFrameParams(const snell::Scene& scene, const GpuScene& gpuScene, const snell::Camera& camera,
                             int width, int height, int supersample, int firstSample, int sampleCount,
-                            int maxDepth, double minWeight, FrameParams* lowParts) {
+                            int maxDepth, double minWeight, double tolerance, std::uint64_t treeBudget,
+                            FrameParams* lowParts) {
     FrameParams f{}, low{};
     // A camera other than the one the layout was built for (the preview's)
     // needs its own start distance.
@@ -185,6 +187,8 @@ FrameParams makeFrameParams(const snell::Scene& scene, const GpuScene& gpuScene,
     if (lowParts) *lowParts = low;
     f.background = toVec4(scene.background, snell::kAirEta);
     f.ambient = toVec4(scene.ambient, minWeight);
+    // +inf stays +inf in float: the shader tests for it.
+    f.radiance = toVec4(snell::radianceBound(scene).radiance, tolerance);
     f.imageWidth = static_cast<uint>(width);
     f.imageHeight = static_cast<uint>(height);
     f.supersample = static_cast<uint>(supersample);
@@ -193,6 +197,7 @@ FrameParams makeFrameParams(const snell::Scene& scene, const GpuScene& gpuScene,
     f.sampleCount = static_cast<uint>(sampleCount > 0 ? std::min(sampleCount, grid - int(f.firstSample))
                                                       : grid - int(f.firstSample));
     f.maxDepth = static_cast<uint>(maxDepth);
+    f.treeBudget = static_cast<uint>(std::min<std::uint64_t>(treeBudget, 0xffffffffu));
     f.sphereCount = static_cast<uint>(gpuScene.spheres.size());
     f.lightCount = static_cast<uint>(gpuScene.lights.size());
     f.bvhNodeCount = static_cast<uint>(gpuScene.nodes.size());

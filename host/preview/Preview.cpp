@@ -146,7 +146,7 @@ private:
     std::unique_ptr<ComputeRenderer> renderer_;
     OrbitCamera camera_;
     Input input_;
-    TraceSettings trace_ = kDefaultSettings;
+    TraceSettings trace_ = kPreviewSettings;
     bool supersampleOn_ = true;
     int size_ = 0;
     // The image so far: the sum of samplesDone_ one-sample images.

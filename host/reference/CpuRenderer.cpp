@@ -1,6 +1,7 @@
 #include "reference/CpuRenderer.h"
 
 #include <algorithm>
+#include <cmath>
 #include <array>
 #include <optional>
 #include <thread>
@@ -42,6 +43,21 @@ struct MediumStack {
 
 double maxComponent(const dvec3& v) { return std::max({v.x, v.y, v.z}); }
 
+// sum += weight ⊙ colour, where a weight grown to +inf (an amplifying tree,
+// SPEC §4) times a colour of 0 adds nothing rather than NaN.
+dvec3 weighted(const dvec3& weight, const dvec3& colour) {
+    dvec3 r(0.0);
+    for (int k = 0; k < 3; ++k)
+        if (colour[k] != 0.0 && weight[k] != 0.0) r[k] = weight[k] * colour[k];
+    return r;
+}
+void addWeighted(dvec3& sum, const dvec3& weight, const dvec3& colour) { sum += weighted(weight, colour); }
+
+// The largest weight a ray carries (as the shader, whose float would overflow):
+// a capped weight is at most the true one, so sums stay lower bounds.
+constexpr double kMaxWeight = 1e30;
+dvec3 childWeight(const dvec3& weight, const dvec3& gain) { return glm::min(weighted(weight, gain), dvec3(kMaxWeight)); }
+
 bool rayHitsBox(const Aabb& box, const dvec3& origin, const dvec3& inverseDir, double tMax) {
     // Slab test; inverseDir components may be ±inf, which the min/max handle.
     double t0 = 0.0, t1 = tMax;
@@ -74,8 +90,18 @@ struct CpuRenderer::PendingRay {
     MediumStack media;
 };
 
+// What one sample's tree did not trace: the weight it dropped (depth limit,
+// cut-off, budget), how many rays it traced and how deep it went.
+struct CpuRenderer::SampleTrace {
+    dvec3 dropped{0.0};
+    std::uint64_t rays = 0;
+    int deepest = 0;
+    bool overBudget = false;
+};
+
 CpuRenderer::CpuRenderer(const Scene& scene) : scene_(scene) {
     amplifying_ = scene.anyAmplifying();
+    radiance_ = radianceBound(scene);
     useBvh_ = scene.spheres.size() > kBvhThreshold;
     if (useBvh_) {
         std::vector<Aabb> bounds;
@@ -156,29 +182,35 @@ bool CpuRenderer::occluded(const Ray& ray, double distance, std::uint32_t fromSp
 // One sample's ray tree (SPEC §4), depth first with an explicit stack, adding
 // each ray's local term straight into pixelSum. A channel whose pixel sum has
 // reached `saturation` is final in 8 bits (SPEC §4 "amplifying materials"), so
-// its weight is dropped from then on.
-void CpuRenderer::trace(const PendingRay& primary, dvec3& pixelSum, double saturation,
-                        const TraceSettings& settings, RayCounts& counts) const {
+// its weight is dropped from then on. Every ray not traced adds its weight to
+// sample.dropped (render/Truncation.h).
+void CpuRenderer::trace(const PendingRay& primary, dvec3& pixelSum, double saturation, double cutOff,
+                        const TraceSettings& settings, RayCounts& counts, SampleTrace& sample) const {
     std::vector<PendingRay> stack;
     stack.push_back(primary);
     ++counts.primary;
-    const double minWeight = settings.minWeight;
     auto worthTracing = [&](const dvec3& w) {
         const double m = maxComponent(w);
-        return m > 0.0 && m >= minWeight;
+        return m > 0.0 && m >= cutOff;
     };
     while (!stack.empty()) {
         PendingRay r = std::move(stack.back());
         stack.pop_back();
         for (int k = 0; k < 3; ++k)
             if (pixelSum[k] >= saturation) r.weight[k] = 0.0;
-        if (!worthTracing(r.weight)) continue;
+        if (!worthTracing(r.weight) || (settings.treeBudget != 0 && sample.rays >= settings.treeBudget)) {
+            if (worthTracing(r.weight)) sample.overBudget = true;
+            sample.dropped += r.weight;
+            continue;
+        }
+        ++sample.rays;
+        sample.deepest = std::max(sample.deepest, r.depth);
 
         // 1. Closest hit.
         Hit hit;
         const StartsOn start = r.inward ? StartsOn::Entering : StartsOn::Leaving;
         if (!closestHit(r.ray, r.fromSphere, start, hit)) {
-            pixelSum += r.weight * scene_.background;
+            addWeighted(pixelSum, r.weight, scene_.background);
             continue;
         }
         const Sphere& sphere = scene_.spheres[hit.sphere];
@@ -218,15 +250,19 @@ void CpuRenderer::trace(const PendingRay& primary, dvec3& pixelSum, double satur
             const double specular = rv > 0.0 ? std::pow(rv, m.phong) : 0.0;
             local += light.colour * (m.kd * nl + m.ks * specular);
         }
-        pixelSum += r.weight * local;
-        if (r.depth >= settings.maxDepth) continue;
+        addWeighted(pixelSum, r.weight, local);
 
         // 4–5. Children: reflection, and refraction through the medium stack.
-        // Pushed reflection first, so refraction is traced next (as the shader).
-        dvec3 reflectedWeight = settings.reflection ? r.weight * m.ks : dvec3(0.0);
+        const dvec3 reflectedGain = settings.reflection ? m.ks : dvec3(0.0);
+        const dvec3 transmittedGain = settings.refraction && m.refracts() ? m.kt : dvec3(0.0);
+        if (r.depth >= settings.maxDepth) {
+            sample.dropped += weighted(r.weight, reflectedGain + transmittedGain);
+            continue;
+        }
+        dvec3 reflectedWeight = childWeight(r.weight, reflectedGain);
         std::optional<PendingRay> refractedRay;
         if (settings.refraction && m.refracts()) {
-            const dvec3 transmittedWeight = r.weight * m.kt;
+            const dvec3 transmittedWeight = childWeight(r.weight, transmittedGain);
             MediumStack media = r.media;
             double etaI, etaT;
             if (fromOutside) {
@@ -242,25 +278,46 @@ void CpuRenderer::trace(const PendingRay& primary, dvec3& pixelSum, double satur
             if (!refractDirection(d, n, etaI / etaT, refracted)) {
                 // Total internal reflection is the reflected ray in the same
                 // medium: one ray carrying both weights (exactly SPEC §4.5).
-                reflectedWeight += transmittedWeight;
+                reflectedWeight = glm::min(reflectedWeight + transmittedWeight, dvec3(kMaxWeight));
             } else if (worthTracing(transmittedWeight)) {
                 refractedRay = PendingRay{{x, refracted}, transmittedWeight, r.depth + 1, hit.sphere,
                                           fromOutside, true, media};
+            } else {
+                sample.dropped += transmittedWeight;
             }
         }
+        std::optional<PendingRay> reflectedRay;
         if (worthTracing(reflectedWeight)) {
-            ++counts.reflected;
-            stack.push_back({{x, reflectDirection(d, n)}, reflectedWeight, r.depth + 1, hit.sphere,
-                             !fromOutside, false, r.media});
+            reflectedRay = PendingRay{{x, reflectDirection(d, n)}, reflectedWeight, r.depth + 1, hit.sphere,
+                                      !fromOutside, false, r.media};
+        } else {
+            sample.dropped += reflectedWeight;
         }
-        if (refractedRay) {
-            ++counts.refracted;
-            stack.push_back(*refractedRay);
-        }
+        if (reflectedRay) ++counts.reflected;
+        if (refractedRay) ++counts.refracted;
+        // The lighter child is traced next and the heavier waits (as the
+        // shader does, whose stack this bounds: ComputeRenderer.cpp); in an
+        // amplifying scene the heavier goes first, so that a tree budget is
+        // spent on the weightiest rays, those that saturate a diverging channel.
+        if (reflectedRay && refractedRay &&
+            (maxComponent(reflectedRay->weight) < maxComponent(refractedRay->weight)) != amplifying_)
+            std::swap(reflectedRay, refractedRay);
+        if (reflectedRay) stack.push_back(std::move(*reflectedRay));
+        if (refractedRay) stack.push_back(std::move(*refractedRay));
     }
 }
 
-glm::dvec3 CpuRenderer::renderPixel(const RenderRequest& request, int x, int y, RayCounts& counts) const {
+// The cut-off a tolerance starts from: the tolerance over the largest finite
+// radiance bound (a few dropped rays then stay within it), at least the floor.
+static double firstCutOff(const TraceSettings& settings, const RadianceBound& radiance) {
+    if (settings.tolerance <= 0.0) return settings.minWeight;
+    double largest = 1.0;
+    for (int c = 0; c < 3; ++c)
+        if (std::isfinite(radiance.radiance[c])) largest = std::max(largest, radiance.radiance[c]);
+    return std::max(settings.minWeight, settings.tolerance / (4.0 * largest));
+}
+
+CpuRenderer::Pixel CpuRenderer::renderPixel(const RenderRequest& request, int x, int y, RayCounts& counts) const {
     const int s = std::max(1, request.supersample);
     const int first = std::clamp(request.firstSample, 0, s * s - 1);
     const int count = request.sampleCount > 0 ? std::min(request.sampleCount, s * s - first) : s * s - first;
@@ -268,48 +325,86 @@ glm::dvec3 CpuRenderer::renderPixel(const RenderRequest& request, int x, int y, 
     // Only amplifying scenes stop saturated channels: elsewhere the float
     // output keeps the whole unclamped sum (SPEC §6).
     const double saturation = amplifying_ ? samples : kNoHit;
-    dvec3 sum(0.0);
-    for (int k = first; k < first + count; ++k) {
-        // SPEC §3: sub-pixel (a, b) at x = i + (a + ½)/s, y = j + (b + ½)/s.
-        const int a = k % s, b = k / s;
-        const double px = x + (a + 0.5) / s;
-        const double py = y + (b + 0.5) / s;
-        PendingRay primary;
-        primary.ray = {request.camera.eye, request.camera.direction(px, py)};
-        trace(primary, sum, saturation, request.trace, counts);
+    const TraceSettings& settings = request.trace;
+    Pixel pixel;
+    // With a tolerance, the pixel is traced again with a 16x lower cut-off
+    // until its bound is within it (or the cut-off reaches its floor), keeping
+    // what each attempt proved (PixelEstimate).
+    PixelEstimate estimate;
+    for (double cutOff = firstCutOff(settings, radiance_);; cutOff = std::max(settings.minWeight, cutOff / 16.0)) {
+        dvec3 sum(0.0);
+        SampleTrace tree;
+        for (int k = first; k < first + count; ++k) {
+            // SPEC §3: sub-pixel (a, b) at x = i + (a + ½)/s, y = j + (b + ½)/s.
+            const int a = k % s, b = k / s;
+            const double px = x + (a + 0.5) / s;
+            const double py = y + (b + 0.5) / s;
+            PendingRay primary;
+            primary.ray = {request.camera.eye, request.camera.direction(px, py)};
+            tree.rays = 0;
+            trace(primary, sum, saturation, cutOff, settings, counts, tree);
+        }
+        estimate.add(radiance_, sum, tree.dropped, samples);
+        pixel.colour = estimate.lower;
+        pixel.bound = estimate.bound();
+        pixel.unbounded = estimate.unbounded();
+        pixel.overBudget = pixel.overBudget || tree.overBudget;
+        pixel.deepest = std::max(pixel.deepest, tree.deepest);
+        const bool within = pixel.bound <= settings.tolerance;
+        pixel.overTolerance = settings.tolerance > 0.0 && !within;
+        if (settings.tolerance <= 0.0 || within || cutOff <= settings.minWeight) break;
     }
-    return sum / samples;
+    return pixel;
 }
 
 Image CpuRenderer::render(const RenderRequest& request, RayCounts* counts) const {
-    // Bands of rows: all of them at once for an image in memory, 32 at a time
-    // when the rows stream to a sink.
-    const int bandRows = request.rowSink ? std::min(32, request.height) : request.height;
-    Image band(request.width, bandRows);
-    Image image = request.rowSink ? Image() : Image(request.width, request.height);
+    // The window rendered (the whole image unless asked), in bands of rows:
+    // all of them at once for an image in memory, 32 at a time when the rows
+    // stream to a sink. Pixel coordinates stay those of the whole image.
+    const PixelWindow area = request.area();
+    const int width = area.width(), height = area.height();
+    const int bandRows = request.rowSink ? std::min(32, height) : height;
+    Image band(width, bandRows);
+    Image image = request.rowSink ? Image() : Image(width, height);
     const int threads = request.threads > 0
                             ? request.threads
                             : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
     std::vector<RayCounts> perThread(threads);
+    std::vector<TruncationReport> truncation(threads);
+    if (request.boundImage) request.boundImage->assign(static_cast<std::size_t>(width) * height, 0.0f);
     std::atomic<int> rowsDone{0};
-    for (int bandStart = 0; bandStart < request.height; bandStart += bandRows) {
-        const int rows = std::min(bandRows, request.height - bandStart);
+    std::atomic<std::uint64_t> raysTraced{0};
+    for (int bandStart = 0; bandStart < height; bandStart += bandRows) {
+        const int rows = std::min(bandRows, height - bandStart);
         Image& target = request.rowSink ? band : image;
         const int targetOffset = request.rowSink ? bandStart : 0;
         std::atomic<int> nextRow{bandStart};
         auto work = [&](int id) {
             RayCounts& local = perThread[id];
-            for (int y; (y = nextRow.fetch_add(1)) < bandStart + rows;) {
+            std::uint64_t raysBefore = local.total();
+            for (int row; (row = nextRow.fetch_add(1)) < bandStart + rows;) {
                 if (request.cancel && request.cancel->load()) return;
-                for (int x = 0; x < request.width; ++x) {
-                    const dvec3 c = renderPixel(request, x, y, local);
-                    float* p = target.pixel(x, y - targetOffset);
+                const int y = area.y0 + row;
+                for (int column = 0; column < width; ++column) {
+                    const int x = area.x0 + column;
+                    const Pixel pixel = renderPixel(request, x, y, local);
+                    const dvec3 c = pixel.colour;
+                    TruncationReport& t = truncation[id];
+                    t.addPixel(x, y, pixel.bound, pixel.unbounded, pixel.overBudget);
+                    t.overTolerance += pixel.overTolerance;
+                    t.deepest = std::max(t.deepest, pixel.deepest);
+                    if (request.boundImage)
+                        (*request.boundImage)[static_cast<std::size_t>(row) * width + column] =
+                            static_cast<float>(pixel.bound);
+                    float* p = target.pixel(column, row - targetOffset);
                     p[0] = static_cast<float>(c.x);
                     p[1] = static_cast<float>(c.y);
                     p[2] = static_cast<float>(c.z);
                 }
                 const int done = rowsDone.fetch_add(1) + 1;
-                if (request.progress) request.progress(static_cast<double>(done) / request.height);
+                const std::uint64_t rays = raysTraced.fetch_add(local.total() - raysBefore) + local.total() - raysBefore;
+                raysBefore = local.total();
+                if (request.progress) request.progress(static_cast<double>(done) / height, rays);
             }
         };
         std::vector<std::thread> pool;
@@ -318,6 +413,10 @@ Image CpuRenderer::render(const RenderRequest& request, RayCounts* counts) const
         for (std::thread& t : pool) t.join();
         if (request.cancel && request.cancel->load()) break;
         if (request.rowSink) request.rowSink(band.rgb.data(), rows);
+    }
+    if (request.truncation) {
+        *request.truncation = TruncationReport{};
+        for (const TruncationReport& t : truncation) request.truncation->merge(t);
     }
     if (counts) {
         *counts = RayCounts{};

@@ -18,14 +18,24 @@ public:
     explicit CpuRenderer(const Scene& scene);
     Image render(const RenderRequest& request, RayCounts* counts = nullptr) const;
 
-    // The colour of one pixel (exposed for tests).
-    glm::dvec3 renderPixel(const RenderRequest& request, int x, int y, RayCounts& counts) const;
+    // One pixel: its colour and what the cut-offs may have cost it.
+    struct Pixel {
+        glm::dvec3 colour{0.0};
+        double bound = 0.0;         // on the clamped colour (render/Truncation.h)
+        bool unbounded = false;     // light was dropped where it need not decay
+        bool overBudget = false;    // a sample's tree reached TraceSettings::treeBudget
+        bool overTolerance = false; // still above the tolerance at the floor cut-off
+        int deepest = 0;            // the deepest ray traced
+    };
+    Pixel renderPixel(const RenderRequest& request, int x, int y, RayCounts& counts) const;
+    const RadianceBound& radiance() const { return radiance_; }
 
 private:
     struct Hit;
     struct PendingRay;
-    void trace(const PendingRay& primary, glm::dvec3& pixelSum, double saturation,
-               const TraceSettings& settings, RayCounts& counts) const;
+    struct SampleTrace;
+    void trace(const PendingRay& primary, glm::dvec3& pixelSum, double saturation, double cutOff,
+               const TraceSettings& settings, RayCounts& counts, SampleTrace& sample) const;
     bool closestHit(const Ray& ray, std::uint32_t fromSphere, StartsOn start, Hit& hit) const;
     bool occluded(const Ray& ray, double distance, std::uint32_t fromSphere, StartsOn start) const;
     double intersect(std::uint32_t sphere, const Ray& ray, std::uint32_t fromSphere, StartsOn start) const;
@@ -34,6 +44,7 @@ private:
     Bvh bvh_;
     bool useBvh_ = false;
     bool amplifying_ = false;
+    RadianceBound radiance_;
 };
 
 }  // namespace snell

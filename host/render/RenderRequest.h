@@ -5,7 +5,9 @@
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <vector>
 
+#include "render/Truncation.h"
 #include "scene/Scene.h"
 
 namespace snell {
@@ -18,12 +20,29 @@ struct TraceSettings {
     bool shadows = true;
     bool reflection = true;
     bool refraction = true;
+    // > 0: trace each pixel until its truncation bound (render/Truncation.h) is
+    // at most this, lowering the cut-off 16x at a time from tolerance / R down
+    // to minWeight, which is then the floor rather than the cut-off.
+    double tolerance = 0.0;
+    // The most rays (closest-hit queries) one sample's tree may trace before it
+    // is stopped and its pixel reported over budget; 0: no limit. Amplifying
+    // trees (SPEC §4) can grow without end; this keeps a render finite.
+    std::uint64_t treeBudget = 0;
 };
 
-// The converged settings used to compute the exact image (SPEC §4).
-inline constexpr TraceSettings kReferenceSettings{64, 1e-7, true, true, true};
-// What `snell render` uses unless told otherwise (docs/design.md, "Defaults").
-inline constexpr TraceSettings kDefaultSettings{64, 1e-4, true, true, true};
+// The exact image (SPEC §4, the limit of the ray tree) as far as it can be
+// certified: depth bounded only by weight (a safety cap far beyond any
+// converged tree), each pixel traced until its truncation bound is below
+// 1/100 of an 8-bit step, and a tree budget that keeps amplifying trees finite.
+inline constexpr TraceSettings kReferenceSettings{10000, 1e-7, true, true, true, 0.01 / 255.0,
+                                                  std::uint64_t(1) << 16};
+// What `snell render` uses unless told otherwise (docs/performance.md,
+// "Defaults"): each pixel certified within half an 8-bit step where the scene
+// allows it, cut-offs no lower than 1e-5, trees of amplifying scenes bounded.
+inline constexpr TraceSettings kDefaultSettings{10000, 1e-5, true, true, true, 0.5 / 255.0,
+                                                std::uint64_t(1) << 16};
+// The preview's, for frames in tens of milliseconds: a fixed depth and cut-off.
+inline constexpr TraceSettings kPreviewSettings{64, 1e-4, true, true, true, 0.0, 0};
 
 struct RayCounts {
     std::uint64_t primary = 0;
@@ -33,10 +52,23 @@ struct RayCounts {
     std::uint64_t total() const { return primary + shadow + reflected + refracted; }
 };
 
+// A window of an image: pixels [x0, x1) × [y0, y1).
+struct PixelWindow {
+    int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+    int width() const { return x1 - x0; }
+    int height() const { return y1 - y0; }
+    bool empty() const { return x1 <= x0 || y1 <= y0; }
+};
+
 struct RenderRequest {
     Camera camera;
     int width = 0;
     int height = 0;
+    // Render only this window of the width × height image (empty: all of
+    // it). The image, its rows and the bound image are then the window's;
+    // every pixel is computed exactly as in the whole image.
+    PixelWindow window;
+    PixelWindow area() const { return window.empty() ? PixelWindow{0, 0, width, height} : window; }
     int supersample = 1;
     // Of the supersample² rays per pixel (SPEC §3, row-major over the
     // sub-pixel grid), trace those from firstSample on, sampleCount of them
@@ -45,14 +77,19 @@ struct RenderRequest {
     int sampleCount = 0;
     TraceSettings trace;
     int threads = 0;  // 0: all hardware threads
-    // Called now and then from worker threads with the fraction done.
-    std::function<void(double)> progress;
+    // Called now and then (from worker threads) with the fraction of pixels
+    // finished and the rays traced so far.
+    std::function<void(double fraction, std::uint64_t rays)> progress;
     // Set to true from anywhere to stop early (the result is then incomplete).
     const std::atomic<bool>* cancel = nullptr;
     // When set, finished rows go here, top to bottom (width * 3 floats per
     // row), and the renderer keeps only a band of rows, not the whole image:
     // the returned image is then empty.
     std::function<void(const float* rgb, int rows)> rowSink;
+    // When set, the truncation of the render is summed here (render/Truncation.h).
+    TruncationReport* truncation = nullptr;
+    // When set, each pixel's truncation bound, row-major (width * height).
+    std::vector<float>* boundImage = nullptr;
 };
 
 }  // namespace snell

@@ -1,0 +1,82 @@
+#include "render/Truncation.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace snell {
+
+bool RadianceBound::finite() const {
+    return std::isfinite(radiance.x) && std::isfinite(radiance.y) && std::isfinite(radiance.z);
+}
+
+RadianceBound radianceBound(const Scene& scene) {
+    RadianceBound b;
+    b.local = scene.background;
+    glm::dvec3 lights(0.0);
+    for (const Light& light : scene.lights) lights += light.colour;
+    for (const Material& m : scene.materials) {
+        b.local = glm::max(b.local, scene.ambient * m.kd + lights * (m.kd + m.ks));
+        b.gain = glm::max(b.gain, m.ks + m.kt);
+    }
+    for (int c = 0; c < 3; ++c) {
+        if (b.local[c] == 0.0) b.radiance[c] = 0.0;  // no light in this channel at all
+        else if (b.gain[c] < 1.0) b.radiance[c] = b.local[c] / (1.0 - b.gain[c]);
+        else b.radiance[c] = std::numeric_limits<double>::infinity();
+    }
+    return b;
+}
+
+void PixelEstimate::add(const RadianceBound& radiance, const glm::dvec3& sum, const glm::dvec3& dropped,
+                        double samples) {
+    for (int c = 0; c < 3; ++c) {
+        const double value = sum[c] / samples;
+        // No light dropped, or none to drop in this channel: exact (0 · inf is 0).
+        const double lost = dropped[c] > 0.0 && radiance.radiance[c] > 0.0 ? dropped[c] * radiance.radiance[c] / samples
+                                                                           : 0.0;
+        lower[c] = std::max(lower[c], value);
+        upper[c] = std::min(upper[c], value + lost);
+    }
+}
+
+double PixelEstimate::bound() const {
+    double worst = 0.0;
+    for (int c = 0; c < 3; ++c) worst = std::max(worst, std::min(upper[c], 1.0) - std::min(lower[c], 1.0));
+    return std::max(worst, 0.0);
+}
+
+bool PixelEstimate::unbounded() const {
+    for (int c = 0; c < 3; ++c)
+        if (std::isinf(upper[c]) && lower[c] < 1.0) return true;
+    return false;
+}
+
+void TruncationReport::addPixel(int x, int y, double bound, bool isUnbounded, bool isOverBudget) {
+    maxBound = std::max(maxBound, bound);
+    sumBound += bound;
+    ++pixels;
+    if (isUnbounded) {
+        ++unbounded;
+        if (unboundedExamples.size() < kExamples) unboundedExamples.push_back({x, y});
+    }
+    if (isOverBudget) {
+        ++overBudget;
+        if (overBudgetExamples.size() < kExamples) overBudgetExamples.push_back({x, y});
+    }
+}
+
+void TruncationReport::merge(const TruncationReport& o) {
+    maxBound = std::max(maxBound, o.maxBound);
+    sumBound += o.sumBound;
+    pixels += o.pixels;
+    unbounded += o.unbounded;
+    overBudget += o.overBudget;
+    overTolerance += o.overTolerance;
+    deepest = std::max(deepest, o.deepest);
+    for (const auto& e : o.unboundedExamples)
+        if (unboundedExamples.size() < kExamples) unboundedExamples.push_back(e);
+    for (const auto& e : o.overBudgetExamples)
+        if (overBudgetExamples.size() < kExamples) overBudgetExamples.push_back(e);
+}
+
+}  // namespace snell

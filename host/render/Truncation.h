@@ -1,0 +1,70 @@
+// What a render's cut-offs may have cost. SPEC §4 defines the exact image as
+// the limit of the ray tree; a renderer stops somewhere (depth limit, weight
+// cut-off, tree budget) and every ray it does not trace carries a known
+// weight w. Whatever that ray would have returned is at most the scene's
+// radiance bound R, so the pixel lost at most w·R in each channel. Every term
+// of the sum is >= 0, so the exact colour lies in [value, value + w·R]; after
+// SPEC §6's clamp, in [value, min(1, value + w·R)].
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <limits>
+#include <vector>
+
+#include "scene/Scene.h"
+
+namespace snell {
+
+// The largest radiance any ray can return in a scene, per channel. A hit's
+// local term is at most L = I_a·kd + Σ_j I_j·(kd + ks) (N·L <= 1, (R·V)^p <= 1,
+// SPEC §4.3) and a miss returns the background B; a ray's children carry at
+// most g = max(ks + kt) of its weight (a totally reflected ray carries both,
+// SPEC §4.5). So R <= max(B, L) + g·R, i.e. R = max(B, L)/(1 − g) where g < 1.
+// Where g >= 1 (SPEC §4 "amplifying materials") light need not decay: R = +inf.
+struct RadianceBound {
+    glm::dvec3 local{0.0};     // max(B, L)
+    glm::dvec3 gain{0.0};      // g
+    glm::dvec3 radiance{0.0};  // R, +inf where g >= 1 (and local > 0)
+    bool finite() const;
+};
+RadianceBound radianceBound(const Scene& scene);
+
+// What is known of one pixel's exact colour after one or more attempts at
+// its ray tree (each with its own cut-off): every attempt's colour is a lower
+// bound, as every term of the sum is >= 0, and its colour plus the light it
+// dropped (dropped weight times R) an upper bound. The pixel keeps the largest
+// lower and the smallest upper bound of each channel, clamped to [0, 1] where
+// the clamp makes them final (SPEC §6). Its bound is the widest gap.
+struct PixelEstimate {
+    glm::dvec3 lower{0.0};  // the colour reported (unclamped)
+    glm::dvec3 upper{std::numeric_limits<double>::infinity()};
+
+    // One attempt: `sum` its colour and `dropped` the weight of the rays it
+    // did not trace, both summed over `samples`.
+    void add(const RadianceBound& radiance, const glm::dvec3& sum, const glm::dvec3& dropped, double samples);
+    // On the clamped colour; a channel whose upper bound is infinite is
+    // bounded by 1 − lower only, and is `unbounded`.
+    double bound() const;
+    bool unbounded() const;
+};
+
+// A render's truncation, summed over its pixels.
+struct TruncationReport {
+    double maxBound = 0.0;
+    double sumBound = 0.0;
+    std::uint64_t pixels = 0;
+    std::uint64_t unbounded = 0;     // pixels whose lost light has no finite bound
+    std::uint64_t overBudget = 0;    // pixels stopped by the tree budget, not finished
+    std::uint64_t overTolerance = 0; // pixels still above the tolerance when the cut-off reached its floor
+    int deepest = 0;                 // the deepest ray traced (generations below the primary ray)
+    static constexpr std::size_t kExamples = 8;
+    std::vector<std::array<int, 2>> unboundedExamples;   // the first few, (x, y)
+    std::vector<std::array<int, 2>> overBudgetExamples;
+
+    double meanBound() const { return pixels ? sumBound / double(pixels) : 0.0; }
+    void addPixel(int x, int y, double bound, bool isUnbounded, bool isOverBudget);
+    void merge(const TruncationReport& other);
+};
+
+}  // namespace snell

@@ -1,0 +1,141 @@
+// The truncation bound (render/Truncation.h): the radiance bound of a scene,
+// and on every scene that a render's stated bound holds against the limit
+// reference, on every scene of scenes/ and of the course. Both renders are
+// the CPU reference in double precision, so the only difference between them
+// is where their ray trees stop.
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "reference/CpuRenderer.h"
+#include "render/Truncation.h"
+#include "scene/Parser.h"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+snell::Scene parse(const std::string& text) { return snell::parseScene(text, "t.scn"); }
+
+TEST(RadianceBound, GeometricSeriesOfTheLargestGain) {
+    // L = I_a kd + I (kd + ks) = 0.1 * 0.5 + 1 * (0.5 + 0.3) = 0.85; g = ks + kt = 0.8.
+    const snell::Scene s = parse(
+        "view 8 1\nbackground 0.2 0.2 0.2\nambient 0.1 0.1 0.1\nlight 1 1 1 0 0 5\n"
+        "material 0.5 0.5 0.5 0.3 0.3 0.3 10\nrefraction 0.5 0.5 0.5 1.5\nsphere\n");
+    const snell::RadianceBound b = snell::radianceBound(s);
+    EXPECT_NEAR(b.local.x, 0.85, 1e-12);
+    EXPECT_NEAR(b.gain.x, 0.8, 1e-12);
+    EXPECT_NEAR(b.radiance.x, 0.85 / 0.2, 1e-9);
+    EXPECT_TRUE(b.finite());
+}
+
+TEST(RadianceBound, InfiniteWhereLightNeedNotDecay) {
+    const snell::Scene s = parse("view 8 1\nlight 1 1 1 0 0 5\nmaterial 0.5 0.5 0.5 0.5 0 0 10\n"
+                                 "refraction 0.6 0 0 1.5\nsphere\n");
+    const snell::RadianceBound b = snell::radianceBound(s);
+    EXPECT_TRUE(std::isinf(b.radiance.x));  // ks + kt = 1.1: amplifying
+    EXPECT_TRUE(std::isfinite(b.radiance.y));
+    EXPECT_FALSE(b.finite());
+}
+
+TEST(PixelEstimate, ClampedToTheHeadroomAndZeroWhenSaturated) {
+    snell::RadianceBound b;
+    b.radiance = glm::dvec3(2.0, std::numeric_limits<double>::infinity(), 1.0);
+    // Red: 0.01 dropped * 2 = 0.02; green: unbounded, 1 - 0.7 = 0.3 of headroom.
+    snell::PixelEstimate e;
+    e.add(b, {0.5, 0.7, 0.2}, {0.01, 0.0, 0.0}, 1.0);
+    EXPECT_NEAR(e.bound(), 0.02, 1e-15);
+    EXPECT_FALSE(e.unbounded());
+    snell::PixelEstimate f;
+    f.add(b, {0.5, 0.7, 0.2}, {0.01, 0.5, 0.0}, 1.0);
+    EXPECT_NEAR(f.bound(), 0.3, 1e-12);
+    EXPECT_TRUE(f.unbounded());
+    // A channel already at 1 is final (SPEC §4, §6).
+    snell::PixelEstimate g;
+    g.add(b, {0.5, 1.0, 0.2}, {0.0, 0.5, 0.0}, 1.0);
+    EXPECT_EQ(g.bound(), 0.0);
+    EXPECT_FALSE(g.unbounded());
+}
+
+TEST(PixelEstimate, KeepsTheBestOfEachAttempt) {
+    snell::RadianceBound b;
+    b.radiance = glm::dvec3(1.0, std::numeric_limits<double>::infinity(), 1.0);
+    snell::PixelEstimate e;
+    // Samples: 2, so the colours are half the sums.
+    e.add(b, {0.4, 1.0, 0.2}, {0.2, 0.2, 0.0}, 2.0);  // red in [0.2, 0.3]; green >= 0.5
+    e.add(b, {0.5, 3.0, 0.2}, {0.1, 0.0, 0.0}, 2.0);  // red in [0.25, 0.3]; green >= 1.5: final
+    EXPECT_NEAR(e.lower.x, 0.25, 1e-15);
+    EXPECT_NEAR(e.upper.x, 0.3, 1e-15);
+    EXPECT_NEAR(e.lower.y, 1.5, 1e-15);
+    EXPECT_NEAR(e.bound(), 0.05, 1e-15);
+    EXPECT_FALSE(e.unbounded());
+}
+
+std::vector<std::string> sceneFiles() {
+    std::vector<std::string> paths;
+    for (const auto& e : fs::recursive_directory_iterator(SNELL_SOURCE_DIR "/scenes"))
+        if (e.path().extension() == ".scn") paths.push_back(e.path().string());
+    // The course's scene files, where the shared directory is beside the project.
+    if (fs::is_directory(SNELL_SOURCE_DIR "/../shared/course-scenes"))
+        for (const auto& e : fs::directory_iterator(SNELL_SOURCE_DIR "/../shared/course-scenes"))
+            if (e.path().extension() == ".scn") paths.push_back(e.path().string());
+    std::sort(paths.begin(), paths.end());
+    return paths;
+}
+
+class BoundHolds : public testing::TestWithParam<std::string> {};
+
+// Every term of the ray tree's sum is >= 0 (SPEC §4), so a truncated render
+// and the limit reference both lie below the exact colour, each within its
+// bound of it: they can differ by no more than the larger bound.
+TEST_P(BoundHolds, ShallowRenderWithinItsBoundOfTheLimit) {
+    const snell::Scene scene = snell::parseSceneFile(GetParam());
+    const snell::CpuRenderer cpu(scene);
+    snell::RenderRequest request;
+    request.width = request.height = 32;
+    request.camera = snell::Camera::fromSpec(32, scene.halfWidth);
+    request.threads = 1;
+    request.supersample = 1;
+    for (const auto& [depth, minWeight] : std::vector<std::pair<int, double>>{{2, 1e-2}, {64, 1e-4}}) {
+        snell::RenderRequest shallow = request, limit = request;
+        shallow.trace = snell::kDefaultSettings;
+        shallow.trace.maxDepth = depth;
+        shallow.trace.minWeight = minWeight;
+        limit.trace = snell::kReferenceSettings;
+        std::vector<float> shallowBound, limitBound;
+        shallow.boundImage = &shallowBound;
+        limit.boundImage = &limitBound;
+        const snell::Image a = cpu.render(shallow), b = cpu.render(limit);
+        int violations = 0;
+        for (int y = 0; y < request.height; ++y)
+            for (int x = 0; x < request.width; ++x)
+                for (int c = 0; c < 3; ++c) {
+                    const double va = std::clamp(double(a.pixel(x, y)[c]), 0.0, 1.0);
+                    const double vb = std::clamp(double(b.pixel(x, y)[c]), 0.0, 1.0);
+                    const std::size_t i = std::size_t(y) * request.width + x;
+                    // Slack: the float image's rounding.
+                    const double stated = std::max(shallowBound[i], limitBound[i]) + 1e-6;
+                    if (std::abs(va - vb) > stated && violations++ < 5)
+                        ADD_FAILURE() << "depth " << depth << ", min-weight " << minWeight << ": pixel (" << x
+                                      << ", " << y << ") channel " << c << " differs by " << std::abs(va - vb)
+                                      << ", stated bound " << stated;
+                }
+        EXPECT_EQ(violations, 0);
+    }
+}
+
+std::string testName(const testing::TestParamInfo<std::string>& info) {
+    std::string n = fs::path(info.param).parent_path().filename().string() + "_" + fs::path(info.param).stem().string();
+    for (char& c : n)
+        if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+    return n;
+}
+
+INSTANTIATE_TEST_SUITE_P(Scenes, BoundHolds, testing::ValuesIn(sceneFiles()), testName);
+
+}  // namespace
