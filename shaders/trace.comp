@@ -118,8 +118,6 @@ vec4 materialKt(uint m) { return texelFetch(materialTexels, int(3u * m + 2u)); }
 const uint NONE = 0xffffffffu;
 
 uint countedRays[SNELL_RAY_COUNTER_COUNT];
-// Shadow rays this invocation cast in this dispatch (for SlotState.rays).
-uint shadowRays = 0u;
 
 // Loop iterations this subgroup has run in this dispatch, as llvmpipe's loop
 // limiter counts them (at least): it counts every pass of a loop with some lane
@@ -281,10 +279,12 @@ bool occluded(rvec3 origin, rvec3 dir, real distance, uint fromSphere, uint star
 // Each pending ray carries its weight, depth, the sphere it starts on, whether
 // it heads into that sphere, and its medium stack (innermost last).
 
-// The cut-off of the pixel in hand: the minimum weight, or under a tolerance
-// the one its current attempt uses (SlotState.dropped.w).
-float cutOff;
-bool worthTracing(vec3 w) {
+// cutOff: that of the pixel in hand, the minimum weight or, under a
+// tolerance, the one its current attempt uses (SlotState.dropped.w). (The
+// per-pixel values live in main's locals and are passed down: Mesa 22.3's
+// llvmpipe keeps memory for every dispatch of a shader with such private
+// globals, tests/soak_test.sh.)
+bool worthTracing(vec3 w, float cutOff) {
     float m = max(w.x, max(w.y, w.z));
     return m > 0.0 && m >= cutOff;
 }
@@ -300,8 +300,6 @@ vec3 weighted(vec3 weight, vec3 colour) {
 // most the true one, so every sum stays a lower bound of the exact colour
 // (render/Truncation.h); its twin is in CpuRenderer.cpp.
 const float MAX_WEIGHT = 1e30;
-// The weight of the rays of this pixel not traced (render/Truncation.h).
-vec3 dropped;
 
 // The ray being traced lives in registers; only a deferred child (the
 // reflected one, when a ray also refracts) goes to the stack in device memory,
@@ -406,7 +404,7 @@ bool findHit(Ray r, vec3 weight, inout vec3 sum, out Hit h) {
 }
 
 // 3. Light j's part of the local Phong term with binary shadows (SPEC §4.3).
-vec3 shadeLight(uint j, Hit h, rvec3 v) {
+vec3 shadeLight(uint j, Hit h, rvec3 v, inout uint shadowRays) {
     rvec3 l = lightPosition(j) - h.point;
     real distance = length(l);
     l *= 1.0 / distance;  // one division, not three
@@ -438,7 +436,9 @@ float addAttempt(inout SlotState state, vec3 droppedWeight, float samples, out b
 // refraction (SPEC §4.5). On return r is the child to trace next (hasRay), the
 // other child having been pushed on the stack; refraction is traced first, as
 // in the CPU reference.
-void spawnChildren(uint slot, inout uint pending, inout Ray r, vec3 weight, Hit h, out bool hasRay) {
+// `dropped` gathers the weight of the children not traced (render/Truncation.h).
+void spawnChildren(uint slot, inout uint pending, inout Ray r, vec3 weight, Hit h, float cutOff, inout vec3 dropped,
+                   out bool hasRay) {
     hasRay = false;
     vec3 reflectedGain = HAS_REFLECTION ? h.ks.rgb : vec3(0.0);
     if (r.depth >= frame.maxDepth) {
@@ -479,14 +479,14 @@ void spawnChildren(uint slot, inout uint pending, inout Ray r, vec3 weight, Hit 
             // Total internal reflection is the reflected ray in the same medium:
             // one ray carries both weights.
             reflectedWeight = min(reflectedWeight + transmittedWeight, vec3(MAX_WEIGHT));
-        } else if (worthTracing(transmittedWeight)) {
+        } else if (worthTracing(transmittedWeight, cutOff)) {
             refracts = true;
             refracted = normalize(eta * d + (eta * c - sqrt(k)) * n);
         } else {
             dropped += transmittedWeight;
         }
     }
-    bool reflects = (HAS_REFLECTION || HAS_REFRACTION) && worthTracing(reflectedWeight);
+    bool reflects = (HAS_REFLECTION || HAS_REFRACTION) && worthTracing(reflectedWeight, cutOff);
     if (!reflects) dropped += reflectedWeight;
     Ray reflectedRay = Ray(h.point, d - 2.0 * dot(d, n) * n, reflectedWeight, r.depth + 1u, h.sphere, !h.fromOutside,
                            r.mediaCount, 0u);
@@ -588,8 +588,9 @@ void main() {
     SlotState state = SlotState(vec4(0.0), vec4(0.0, 0.0, 0.0, firstCutOff), vec4(0.0), vec4(INFINITY), slot, 0u, 0u,
                                 0u, 0u, 0u, 0u, 0u);
     if (tile.resume != 0u) state = slotStates[slot];
-    dropped = state.dropped.rgb;
-    cutOff = state.dropped.w;
+    vec3 dropped = state.dropped.rgb;  // the weight of this pixel's rays not traced
+    float cutOff = state.dropped.w;
+    uint shadowRays = 0u;               // cast in this dispatch (for SlotState.rays)
     uint deepest = 0u;
     bool done = state.pixel >= tilePixels;
     uvec2 pixel = uvec2(state.pixel % tile.width, state.pixel / tile.width);  // within the tile
@@ -675,8 +676,8 @@ void main() {
                 weight = mix(weight, vec3(0.0), greaterThanEqual(state.sum.rgb, vec3(saturation)));
             // A sample's tree past the budget: the rest of it is dropped.
             bool overBudget = frame.treeBudget != 0u && state.treeRays >= frame.treeBudget && ray.resumeShading == 0u;
-            if (overBudget && worthTracing(weight)) state.overBudget = 1u;
-            if (worthTracing(weight) && !overBudget) {
+            if (overBudget && worthTracing(weight, cutOff)) state.overBudget = 1u;
+            if (worthTracing(weight, cutOff) && !overBudget) {
                 if (ray.resumeShading == 0u) {
                     state.treeRays++;
                     state.rays++;
@@ -696,7 +697,7 @@ void main() {
         // (the same sums whether or not shading is suspended part-way).
         rvec3 v = -ray.dir;
         if (HAS_LIGHTS && LOOP_BUDGET == 0u && shading) {
-            for (uint j = 0u; j < frame.lightCount; ++j) state.sum.rgb += weighted(weight, shadeLight(j, h, v));
+            for (uint j = 0u; j < frame.lightCount; ++j) state.sum.rgb += weighted(weight, shadeLight(j, h, v, shadowRays));
         }
         if (HAS_LIGHTS && LOOP_BUDGET != 0u) {
             // Every lane runs this loop (it is not inside `if (shading)`), so the
@@ -716,11 +717,11 @@ void main() {
                     break;
                 }
                 tick(2u);  // this light, and the occlusion loop should no lane enter it
-                if (shading && j + 1u >= ray.resumeShading) state.sum.rgb += weighted(weight, shadeLight(j, h, v));
+                if (shading && j + 1u >= ray.resumeShading) state.sum.rgb += weighted(weight, shadeLight(j, h, v, shadowRays));
             }
             if (suspended) break;
         }
-        if (shading) spawnChildren(slot, state.pending, ray, weight, h, hasRay);
+        if (shading) spawnChildren(slot, state.pending, ray, weight, h, cutOff, dropped, hasRay);
     }
 
     if (suspended) {

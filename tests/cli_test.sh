@@ -155,6 +155,18 @@ fi
 "$SNELL" render "$SCENES/showcase.scn" --size 64 -o "$work/prog2.png" 2>"$work/err"
 ! grep -q "elapsed" "$work/err" && ok || bad "progress written to a non-terminal"
 
+# No runaway trees: settings that let an amplifying tree grow without bound
+# are refused before tracing (status 2, naming the sphere's material and a
+# setting that finishes), unless asked for explicitly.
+"$SNELL" render "$SCENES/glass.scn" --size 8 --tree-budget 0 --min-weight 0 -o "$work/run.png" 2>"$work/err"; status=$?
+[ $status -eq 2 ] && [ ! -e "$work/run.png" ] && grep -q "glass.scn:[0-9]*:[0-9]*: error: .*ks + kt = 1.05" "$work/err" &&
+  grep -q -- "--tree-budget 65536" "$work/err" && grep -q -- "--allow-runaway" "$work/err" && ok ||
+  bad "runaway tree not refused ($status): $(cat "$work/err")"
+"$SNELL" render "$SCENES/glass.scn" --size 8 -q --tree-budget 0 --min-weight 0 --depth 4 --allow-runaway -o "$work/run.png" &&
+  ok || bad "--allow-runaway"
+"$SNELL" render "$SCENES/mirrors.scn" --size 8 -q --tree-budget 0 --min-weight 0 -o "$work/run.png" &&
+  ok || bad "a chain of mirrors without cut-off is bounded by its depth and must render"
+
 # -o - streams PPM to standard output (and --stats moves to standard error).
 "$SNELL" render "$SCENES/basic.scn" --size 16 -o - -q --stats >"$work/pipe.ppm" 2>"$work/err"; status=$?
 [ $status -eq 0 ] && [ "$(head -c 2 "$work/pipe.ppm")" = "P6" ] && [ "$(wc -c <"$work/pipe.ppm")" -eq $((13 + 16 * 16 * 3)) ] &&

@@ -90,6 +90,7 @@ struct RenderOptions {
     std::optional<std::uint64_t> treeBudget;
     std::string boundImage;
     std::vector<int> region;  // X0 Y0 X1 Y1, or empty
+    bool allowRunaway = false;
     std::optional<int> supersample;
     int gpu = -1;
     std::string precision = "fp32";
@@ -233,6 +234,26 @@ int runRender(const RenderOptions& o) {
     if (o.minWeight) request.trace.minWeight = *o.minWeight;
     if (o.tolerance) request.trace.tolerance = *o.tolerance;
     if (o.treeBudget) request.trace.treeBudget = *o.treeBudget;
+    // No runaway trees: without a tree budget, the settings must bound each
+    // sample's tree to a size that finishes (render/Truncation.h).
+    if (request.trace.treeBudget == 0 && !o.allowRunaway) {
+        constexpr double kMaxLog2Rays = 32;  // 4·10⁹ rays a sample
+        const snell::TreeSizeBound tree =
+            snell::treeSizeBound(scene, request.trace.maxDepth, request.trace.minWeight);
+        if (tree.log2Rays > kMaxLog2Rays) {
+            const snell::TextPosition at = scene.spheres[tree.sphere].location;
+            std::ostringstream rays;
+            rays << (std::isinf(tree.log2Rays) ? std::string("without bound") : "up to 2^" + std::to_string(int(tree.log2Rays)) + " rays");
+            std::cerr << o.scene << ":" << at.line << ":" << at.column << ": error: the material of this sphere has "
+                      << "ks + kt = " << tree.gain << " in a channel; with --depth " << request.trace.maxDepth
+                      << ", --min-weight " << request.trace.minWeight << " and --tree-budget 0 a sample's ray tree "
+                      << "can grow " << rays.str() << ", and the render may never end. Use --tree-budget "
+                      << snell::kDefaultSettings.treeBudget << " (the default)";
+            if (tree.gain <= 1.0) std::cerr << " or --min-weight " << snell::kDefaultSettings.minWeight;
+            std::cerr << ", or --allow-runaway to trace it anyway\n";
+            return kExitInput;
+        }
+    }
     snell::TruncationReport truncation;
     request.truncation = &truncation;
     std::vector<float> boundImage;
@@ -604,8 +625,11 @@ int main(int argc, char** argv) {
                        "(default: GPU 0.5/255 = 0.00196, exact in 8 bits; CPU 0.01/255)")
         ->check(kFinite)->check(CLI::Range(0.0, 1.0));
     render->add_option("--tree-budget", ro.treeBudget,
-                       "Stop a sample's ray tree after N rays and report its pixel (default: 65536)")
-        ->check(CLI::PositiveNumber);
+                       "Stop a sample's ray tree after N rays and report its pixel; 0: no limit (default: 65536)")
+        ->check(CLI::NonNegativeNumber);
+    render->add_flag("--allow-runaway", ro.allowRunaway,
+                     "Trace even when the settings allow a ray tree of astronomical size (no tree budget, and "
+                     "amplifying materials or no cut-off): the render may never end");
     render->add_option("--bound-image", ro.boundImage,
                        "Also write each pixel's truncation bound (how far it may be from the exact image) to FILE "
                        "(.pfm or .exr keep it unclamped)")

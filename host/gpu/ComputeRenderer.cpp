@@ -69,6 +69,7 @@ struct ComputeRenderer::Pipeline {
     // alternates sizes while the camera moves).
     VkDeviceSize tilePixels = 0;
     VkDeviceSize slots = 0;  // persistent invocations
+    int dispatches = 0;      // by this pipeline object (see kPassesPerPipeline)
 };
 
 ComputeRenderer::ComputeRenderer(vk::Context& context, const Scene& scene, const Camera& camera,
@@ -205,6 +206,25 @@ ComputeRenderer::Specialisation ComputeRenderer::specialise(const RenderRequest&
     return values;
 }
 
+// The pipeline object alone, for p's module, layout and specialisation.
+void ComputeRenderer::createComputePipeline(Pipeline& p) {
+    std::array<VkSpecializationMapEntry, SNELL_SPEC_COUNT> entries{};
+    for (std::uint32_t i = 0; i < entries.size(); ++i)
+        entries[i] = {i, i * static_cast<std::uint32_t>(sizeof(std::uint32_t)), sizeof(std::uint32_t)};
+    VkSpecializationInfo spec{static_cast<std::uint32_t>(entries.size()), entries.data(),
+                              p.values.size() * sizeof(std::uint32_t), p.values.data()};
+    VkComputePipelineCreateInfo pipelineInfo{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
+    pipelineInfo.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
+    pipelineInfo.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
+    pipelineInfo.stage.module = p.module;
+    pipelineInfo.stage.pName = "main";
+    pipelineInfo.stage.pSpecializationInfo = &spec;
+    pipelineInfo.layout = p.layout;
+    check(vkCreateComputePipelines(context_.device(), context_.pipelineCache(), 1, &pipelineInfo, nullptr,
+                                   &p.pipeline),
+          "vkCreateComputePipelines");
+}
+
 void ComputeRenderer::createPipeline(const Specialisation& values, Pipeline& p) {
     VkDevice device = context_.device();
     p.values = values;
@@ -237,20 +257,7 @@ void ComputeRenderer::createPipeline(const Specialisation& values, Pipeline& p) 
 
     p.rayStackDepth = values[SNELL_SPEC_RAY_STACK];
     p.maxMedia = values[SNELL_SPEC_MAX_MEDIA];
-    std::array<VkSpecializationMapEntry, SNELL_SPEC_COUNT> entries{};
-    for (std::uint32_t i = 0; i < entries.size(); ++i)
-        entries[i] = {i, i * static_cast<std::uint32_t>(sizeof(std::uint32_t)), sizeof(std::uint32_t)};
-    VkSpecializationInfo spec{static_cast<std::uint32_t>(entries.size()), entries.data(),
-                              values.size() * sizeof(std::uint32_t), values.data()};
-    VkComputePipelineCreateInfo pipelineInfo{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
-    pipelineInfo.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
-    pipelineInfo.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
-    pipelineInfo.stage.module = p.module;
-    pipelineInfo.stage.pName = "main";
-    pipelineInfo.stage.pSpecializationInfo = &spec;
-    pipelineInfo.layout = p.layout;
-    check(vkCreateComputePipelines(device, context_.pipelineCache(), 1, &pipelineInfo, nullptr, &p.pipeline),
-          "vkCreateComputePipelines");
+    createComputePipeline(p);
 
     std::array<VkDescriptorPoolSize, 3> sizes{{{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 0},
                                                {VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, 0},
@@ -319,6 +326,8 @@ void memoryBarrier(VkCommandBuffer cmd, VkAccessFlags srcAccess, VkAccessFlags d
     vkCmdPipelineBarrier(cmd, srcStage, dstStage, 0, 1, &b, 0, nullptr, 0, nullptr);
 }
 
+// Dispatches a pipeline object serves where the driver limits loops (render()).
+constexpr int kPassesPerPipeline = 8;
 // Device memory for the invocations' ray stacks.
 constexpr VkDeviceSize kStackBudget = 64ull << 20;
 // The largest tile side: an image is rendered (and streamed) tile by tile.
@@ -531,6 +540,18 @@ GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool count
                 };
                 for (int pass = 0;; ++pass) {
                     if (request.cancel && request.cancel->load()) throw vk::VulkanError("render cancelled");
+                    // Mesa 22.3's llvmpipe (the driver that limits loops) keeps
+                    // memory from every dispatch of this shader until its
+                    // pipeline is destroyed, ~0.5 MB a dispatch: a new pipeline
+                    // object (from the pipeline cache, ~60 ms) every few
+                    // dispatches keeps a long render or preview flat
+                    // (tests/soak_test.sh).
+                    if (loopBudget_ != 0 && ++p.dispatches > kPassesPerPipeline) {
+                        vkDestroyPipeline(device, p.pipeline, nullptr);
+                        p.pipeline = VK_NULL_HANDLE;
+                        createComputePipeline(p);
+                        p.dispatches = 1;
+                    }
                     std::memset(counters, 0, SNELL_COUNTER_COUNT * sizeof(std::uint32_t));
                     tile.resume = pass > 0 ? 1u : 0u;
                     if (pass == 0) std::memset(p.slotStates.mapped, 0, slots * sizeof(gpu::SlotState));

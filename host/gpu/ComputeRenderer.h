@@ -56,6 +56,7 @@ private:
     using Specialisation = std::array<std::uint32_t, SNELL_SPEC_COUNT>;
     Specialisation specialise(const RenderRequest& request, bool countRays) const;
     void createPipeline(const Specialisation& values, Pipeline& pipeline);
+    void createComputePipeline(Pipeline& pipeline);
     void destroyPipeline(Pipeline& pipeline);
     void destroyBuffers();
     bool spheresInBlock() const;  // every sphere in the uniform block (shared_layout.h)

@@ -51,6 +51,33 @@ bool PixelEstimate::unbounded() const {
     return false;
 }
 
+TreeSizeBound treeSizeBound(const Scene& scene, int maxDepth, double minWeight) {
+    TreeSizeBound b;
+    bool branches = false;  // a hit can have two children
+    for (std::size_t i = 0; i < scene.spheres.size(); ++i) {
+        const Material& m = scene.materials[scene.spheres[i].material];
+        branches = branches || (m.reflects() && m.refracts());
+        const double g = std::max({m.ks.x + m.kt.x, m.ks.y + m.kt.y, m.ks.z + m.kt.z});
+        if (g > b.gain) {
+            b.gain = g;
+            b.sphere = i;
+        }
+    }
+    if (b.gain == 0.0) return b;  // no secondary rays: one ray a sample
+    // log2 of sum over d <= D of min(2^d, g^d / w), summed in the log domain.
+    double total = -std::numeric_limits<double>::infinity();
+    const double log2w = minWeight > 0.0 ? std::log2(minWeight) : -std::numeric_limits<double>::infinity();
+    const double log2g = std::log2(b.gain);
+    for (int d = 0; d <= maxDepth; ++d) {
+        const double level = std::min(branches ? double(d) : 0.0, d * log2g - log2w);
+        if (level < 0.0 && d > 0 && log2g <= 0.0) break;  // no ray this deep reaches the cut-off
+        total = std::max(total, level) + std::log2(1.0 + std::exp2(-std::abs(total - level)));
+        if (total > 1e4) return b.log2Rays = std::numeric_limits<double>::infinity(), b;
+    }
+    b.log2Rays = total;
+    return b;
+}
+
 void TruncationReport::addPixel(int x, int y, double bound, bool isUnbounded, bool isOverBudget) {
     maxBound = std::max(maxBound, bound);
     sumBound += bound;

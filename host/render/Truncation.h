@@ -49,6 +49,19 @@ struct PixelEstimate {
     bool unbounded() const;
 };
 
+// The most rays one sample's tree can hold under a depth limit D, a weight
+// cut-off w and no tree budget, from the materials alone: level d of the tree
+// holds at most 2^d rays (1 where no material both reflects and refracts), and (as children carry at most g = max(ks + kt) of
+// their parent's weight) their weights sum to at most g^d, so at most
+// g^d / w of them reach the cut-off. Returned as log2 of the count (+inf: no
+// bound), with the sphere whose material has the largest g.
+struct TreeSizeBound {
+    double log2Rays = 0.0;
+    double gain = 0.0;              // g
+    std::size_t sphere = 0;         // a sphere with that material
+};
+TreeSizeBound treeSizeBound(const Scene& scene, int maxDepth, double minWeight);
+
 // A render's truncation, summed over its pixels.
 struct TruncationReport {
     double maxBound = 0.0;
