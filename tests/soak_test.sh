@@ -6,8 +6,10 @@
 # first band (SOAK_SETTLE seconds), in which the image, the pipeline and the
 # invocations' stacks are allocated once. On Debian 12's Mesa 22.3 lavapipe,
 # which needs a dispatch every few milliseconds, an earlier kernel grew by
-# 0.55 MB a dispatch (docs/performance.md). The render is then ended with
-# SIGTERM and must exit 143, leaving no file.
+# 0.55 MB a dispatch and the present one keeps about 0.1 MB a second after
+# its pipeline recycling (README, Known issues): the bound catches any return
+# of the former. The render is then ended with SIGTERM and must exit 143,
+# leaving no file.
 set -u
 : "${SNELL:?}"
 seconds=${SOAK_SECONDS:-120}
