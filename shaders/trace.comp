@@ -510,8 +510,9 @@ void spawnChildren(uint slot, inout uint pending, inout Ray r, vec3 weight, Hit 
                           max(reflectedWeight.r, max(reflectedWeight.g, reflectedWeight.b))) != AMPLIFYING;
         // One entry stays free for the ray in hand should the invocation suspend.
         if (pending + 1u >= RAY_STACK) {
-            // Full (only an amplifying tree can fill it): the heavier child is
-            // dropped, its weight counted in the bound, and the host says so.
+            // Full (only an amplifying tree can fill it): the child that would
+            // wait is dropped, its weight counted in the bound, and the host
+            // says so.
             dropped += refractedWaits ? transmittedWeight : reflectedWeight;
             atomicAdd(counters[SNELL_COUNTER_OVERFLOW], 1u);
             if (refractedWaits) {

@@ -101,11 +101,21 @@ TEST_P(BoundHolds, ShallowRenderWithinItsBoundOfTheLimit) {
     request.camera = snell::Camera::fromSpec(32, scene.halfWidth);
     request.threads = 1;
     request.supersample = 1;
-    for (const auto& [depth, minWeight] : std::vector<std::pair<int, double>>{{2, 1e-2}, {64, 1e-4}}) {
+    // Fixed cut-offs (depth 2 at 1e-2, the former default depth 64 at 1e-4)
+    // and the default tolerance.
+    struct Shallow {
+        int depth;
+        double minWeight, tolerance;
+    };
+    for (const auto& [depth, minWeight, tolerance] :
+         std::vector<Shallow>{{2, 1e-2, 0.0}, {64, 1e-4, 0.0}, {snell::kDefaultSettings.maxDepth,
+                                                                 snell::kDefaultSettings.minWeight,
+                                                                 snell::kDefaultSettings.tolerance}}) {
         snell::RenderRequest shallow = request, limit = request;
         shallow.trace = snell::kDefaultSettings;
         shallow.trace.maxDepth = depth;
         shallow.trace.minWeight = minWeight;
+        shallow.trace.tolerance = tolerance;
         limit.trace = snell::kReferenceSettings;
         std::vector<float> shallowBound, limitBound;
         shallow.boundImage = &shallowBound;
@@ -121,7 +131,8 @@ TEST_P(BoundHolds, ShallowRenderWithinItsBoundOfTheLimit) {
                     // Slack: the float image's rounding.
                     const double stated = std::max(shallowBound[i], limitBound[i]) + 1e-6;
                     if (std::abs(va - vb) > stated && violations++ < 5)
-                        ADD_FAILURE() << "depth " << depth << ", min-weight " << minWeight << ": pixel (" << x
+                        ADD_FAILURE() << "depth " << depth << ", min-weight " << minWeight << ", tolerance "
+                                      << tolerance << ": pixel (" << x
                                       << ", " << y << ") channel " << c << " differs by " << std::abs(va - vb)
                                       << ", stated bound " << stated;
                 }

@@ -157,7 +157,7 @@ namespace {
 // log q: 14 for the default 1e-4 and glass of ks 0.5, however deep the tree,
 // and a chain of reflections needs none. Otherwise (amplifying materials, no
 // cut-off) the depth limit bounds k, up to kMaxRayStack; past that the
-// shader drops the heavier child and counts it (SNELL_COUNTER_OVERFLOW).
+// shader drops the child that would wait and counts it (SNELL_COUNTER_OVERFLOW).
 constexpr std::uint32_t kMaxRayStack = 256;
 std::uint32_t rayStackEntries(const Scene& scene, const TraceSettings& trace, bool reflection) {
     if (!reflection) return 0;
