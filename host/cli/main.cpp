@@ -163,20 +163,23 @@ private:
 // Where the render may still differ from the exact image (SPEC §4 limit):
 // pixels whose dropped light has no finite bound, or whose tree was stopped.
 void reportTruncation(const snell::TruncationReport& t, const snell::TraceSettings& settings) {
+    // ", e.g. (x, y), ...", or nothing where the renderer kept no coordinates
+    // (the GPU counts its over-budget pixels only).
     auto examples = [](const std::vector<std::array<int, 2>>& pixels, std::uint64_t count) {
         std::string s;
         for (const auto& p : pixels) s += (s.empty() ? "" : ", ") + ("(" + std::to_string(p[0]) + ", " + std::to_string(p[1]) + ")");
+        if (s.empty()) return s;
         if (count > pixels.size()) s += ", ...";
-        return s;
+        return ", e.g. " + s;
     };
     if (t.unbounded > 0)
         std::cerr << "snell: warning: " << t.unbounded << " pixel(s) dropped light of a material with ks + kt >= 1, "
-                  << "which need not decay: their bound is only the clamp to 1 (--bound-image shows it), e.g. "
+                  << "which need not decay: their bound is only the clamp to 1 (--bound-image shows it)"
                   << examples(t.unboundedExamples, t.unbounded) << "\n";
     if (t.overBudget > 0)
         std::cerr << "snell: warning: " << t.overBudget << " pixel(s) reached the tree budget of "
                   << settings.treeBudget << " rays a sample and were stopped (their bound says by how much they "
-                  << "may still move), e.g. " << examples(t.overBudgetExamples, t.overBudget) << "\n";
+                  << "may still move)" << examples(t.overBudgetExamples, t.overBudget) << "\n";
     if (t.overTolerance > t.unbounded)
         std::cerr << "snell: warning: " << t.overTolerance << " pixel(s) are above the tolerance "
                   << settings.tolerance << " at the floor cut-off " << settings.minWeight
