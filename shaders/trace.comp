@@ -581,7 +581,15 @@ void main() {
     // rays on its stack. Fresh, or resumed from the last dispatch.
     // Under a tolerance each pixel starts at the tolerance over the largest
     // finite radiance bound (as CpuRenderer::renderPixel does).
-    float tolerance = frame.radiance.w;
+    // Mesa 22.3's lavapipe specialises a shader on values it reads from
+    // uniforms with constant offsets where it judges that worthwhile
+    // (lvp_inline_uniforms); for this kernel it judged so because of the
+    // tolerance, and then compiled a new copy of the kernel at every dispatch
+    // and kept each one (an LLVM compile and ~0.75 MB a dispatch). A zero it
+    // cannot see as uniform (dispatches are one row of workgroups) keeps the
+    // tolerance out of that analysis; tests/soak_test.sh watches for it.
+    uint opaqueZero = gl_NumWorkGroups.y - 1u;
+    float tolerance = frame.radiance.w + float(opaqueZero);
     float largestRadiance = 1.0;
     [[unroll]] for (int c = 0; c < 3; ++c)
         if (!isinf(frame.radiance[c])) largestRadiance = max(largestRadiance, frame.radiance[c]);

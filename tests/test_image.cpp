@@ -202,6 +202,31 @@ TEST_F(ImageFiles, ExrRoundTripIsExactAndUnclamped) {
     for (int i = 0; i < 18; ++i) EXPECT_EQ(back.rgb[i], values[i]) << i;
 }
 
+// A piece of a larger image: EXR keeps where it lies (data window inside the
+// display window) and its rows, written in several calls, in order.
+TEST_F(ImageFiles, ExrKeepsItsPlacementAndStreamsRows) {
+    Image image(4, 3);
+    for (std::size_t i = 0; i < image.rgb.size(); ++i) image.rgb[i] = float(i) * 0.25f - 1.0f;
+    auto writer = snell::ImageWriter::open(path("piece.exr"), 4, 3, {{"Region", "5 7 of 16x20"}}, {5, 7, 16, 20});
+    writer->writeRows(image.rgb.data(), 1);
+    writer->writeRows(image.pixel(0, 1), 2);
+    writer->commit();
+    snell::ImagePlacement placement;
+    const Image back = snell::readImage(path("piece.exr"), &placement);
+    EXPECT_TRUE(placement.stored);
+    EXPECT_EQ(placement.x, 5);
+    EXPECT_EQ(placement.y, 7);
+    EXPECT_EQ(placement.fullWidth, 16);
+    EXPECT_EQ(placement.fullHeight, 20);
+    ASSERT_EQ(back.width, 4);
+    ASSERT_EQ(back.height, 3);
+    EXPECT_EQ(back.rgb, image.rgb);
+    // Formats without a window say so.
+    snell::writeImage(path("piece.pfm"), image);
+    snell::readImage(path("piece.pfm"), &placement);
+    EXPECT_FALSE(placement.stored);
+}
+
 TEST(ImageFormat, ByExtension) {
     EXPECT_EQ(snell::formatForPath("a.png"), snell::ImageFormat::Png);
     EXPECT_EQ(snell::formatForPath("dir.x/a.ppm"), snell::ImageFormat::Ppm);

@@ -293,7 +293,9 @@ int runRender(const RenderOptions& o) {
         if (!o.region.empty())
             text.push_back({"Region", std::to_string(area.x0) + " " + std::to_string(area.y0) + " of " +
                                           std::to_string(size) + "x" + std::to_string(size)});
-        writer = snell::ImageWriter::open(output, area.width(), area.height(), text);
+        // EXR keeps the window as its data window within the whole image.
+        const snell::ImagePlacement placement{area.x0, area.y0, size, size};
+        writer = snell::ImageWriter::open(output, area.width(), area.height(), text, placement);
     } catch (const snell::ImageIOError& e) {
         std::cerr << "snell: error: " << e.what() << "\n";
         return kExitRuntime;
@@ -429,10 +431,10 @@ int runRender(const RenderOptions& o) {
     return 0;
 }
 
-// `snell assemble`: pieces rendered with --region, each given as X,Y:FILE (its
-// top-left pixel in the whole image), into one image; every pixel must be
-// covered. The pieces are pixels of the same render, so the result is the
-// whole render, bit for bit.
+// `snell assemble`: pieces rendered with --region into one image; every
+// pixel must be covered. A piece is X,Y:FILE (its top-left pixel in the whole
+// image), or an EXR FILE alone, placed by its data window. The pieces are
+// pixels of the same render, so the result is the whole render, bit for bit.
 int runAssemble(const std::string& output, const std::vector<std::string>& pieces, int size) {
     struct Piece {
         int x = 0, y = 0;
@@ -444,25 +446,44 @@ int runAssemble(const std::string& output, const std::vector<std::string>& piece
         Piece p;
         const auto colon = arg.find(':');
         const auto comma = arg.find(',');
-        char* end = nullptr;
-        bool ok = colon != std::string::npos && comma != std::string::npos && comma < colon;
-        if (ok) {
+        const bool placed = colon != std::string::npos && comma != std::string::npos && comma < colon;
+        const std::string file = placed ? arg.substr(colon + 1) : arg;
+        if (placed) {
+            char* end = nullptr;
             p.x = int(std::strtol(arg.c_str(), &end, 10));
-            ok = end == arg.c_str() + comma;
-        }
-        if (ok) {
+            bool ok = end == arg.c_str() + comma;
             p.y = int(std::strtol(arg.c_str() + comma + 1, &end, 10));
-            ok = end == arg.c_str() + colon && p.x >= 0 && p.y >= 0;
+            ok = ok && end == arg.c_str() + colon && p.x >= 0 && p.y >= 0;
+            if (!ok) {
+                std::cerr << "snell: error: a piece is X,Y:FILE (its top-left pixel, then the file), got '" << arg
+                          << "'\n";
+                return kExitInput;
+            }
         }
-        if (!ok) {
-            std::cerr << "snell: error: a piece is X,Y:FILE (its top-left pixel, then the file), got '" << arg << "'\n";
-            return kExitInput;
-        }
+        snell::ImagePlacement placement;
         try {
-            p.image = snell::readImage(arg.substr(colon + 1));
+            p.image = snell::readImage(file, &placement);
         } catch (const std::exception& e) {
             std::cerr << "snell: error: " << e.what() << "\n";
             return kExitRuntime;
+        }
+        if (!placed) {
+            if (!placement.stored) {
+                std::cerr << "snell: error: '" << arg << "' does not say where it goes (only EXR keeps its "
+                          << "window): give it as X,Y:FILE\n";
+                return kExitInput;
+            }
+            if (placement.x < 0 || placement.y < 0) {
+                std::cerr << "snell: error: '" << arg << "' lies outside its display window\n";
+                return kExitInput;
+            }
+            p.x = placement.x;
+            p.y = placement.y;
+            // The whole image's size, from the display window, unless -s says it.
+            if (size == 0) {
+                width = std::max(width, placement.fullWidth);
+                height = std::max(height, placement.fullHeight);
+            }
         }
         width = std::max(width, p.x + p.image.width);
         height = std::max(height, p.y + p.image.height);
@@ -709,7 +730,8 @@ int main(int argc, char** argv) {
     assemble->add_option("-o,--output", assembleOutput, "The whole image (.png, .ppm, .pfm or .exr)")
         ->required()->check(kImageFormat);
     assemble->add_option("pieces", assemblePieces, "Each piece as X,Y:FILE, X and Y its top-left pixel (X0 and Y0 "
-                                                   "of its --region)")->required();
+                                                   "of its --region), or an EXR file alone (placed by its data "
+                                                   "window)")->required();
     assemble->add_option("-s,--size", assembleSize, "The whole image's size, so a missing piece is an error "
                                                     "(default: the extent of the pieces)")
         ->check(CLI::Range(1, snell::ParseLimits::kMaxImageSize));

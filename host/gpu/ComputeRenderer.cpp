@@ -69,7 +69,6 @@ struct ComputeRenderer::Pipeline {
     // alternates sizes while the camera moves).
     VkDeviceSize tilePixels = 0;
     VkDeviceSize slots = 0;  // persistent invocations
-    int dispatches = 0;      // by this pipeline object (see kPassesPerPipeline)
 };
 
 ComputeRenderer::ComputeRenderer(vk::Context& context, const Scene& scene, const Camera& camera,
@@ -326,8 +325,6 @@ void memoryBarrier(VkCommandBuffer cmd, VkAccessFlags srcAccess, VkAccessFlags d
     vkCmdPipelineBarrier(cmd, srcStage, dstStage, 0, 1, &b, 0, nullptr, 0, nullptr);
 }
 
-// Dispatches a pipeline object serves where the driver limits loops (render()).
-constexpr int kPassesPerPipeline = 8;
 // Device memory for the invocations' ray stacks.
 constexpr VkDeviceSize kStackBudget = 64ull << 20;
 // The largest tile side: an image is rendered (and streamed) tile by tile.
@@ -540,18 +537,6 @@ GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool count
                 };
                 for (int pass = 0;; ++pass) {
                     if (request.cancel && request.cancel->load()) throw vk::VulkanError("render cancelled");
-                    // Mesa 22.3's llvmpipe (the driver that limits loops) keeps
-                    // memory from every dispatch of this shader until its
-                    // pipeline is destroyed, ~0.5 MB a dispatch: a new pipeline
-                    // object (from the pipeline cache, ~60 ms) every few
-                    // dispatches keeps a long render or preview flat
-                    // (tests/soak_test.sh).
-                    if (loopBudget_ != 0 && ++p.dispatches > kPassesPerPipeline) {
-                        vkDestroyPipeline(device, p.pipeline, nullptr);
-                        p.pipeline = VK_NULL_HANDLE;
-                        createComputePipeline(p);
-                        p.dispatches = 1;
-                    }
                     std::memset(counters, 0, SNELL_COUNTER_COUNT * sizeof(std::uint32_t));
                     tile.resume = pass > 0 ? 1u : 0u;
                     if (pass == 0) std::memset(p.slotStates.mapped, 0, slots * sizeof(gpu::SlotState));

@@ -7,8 +7,14 @@
 #include <random>
 #include <sstream>
 
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfIO.h>
+#include <ImfInputFile.h>
+#include <ImfOutputFile.h>
+#include <ImfStringAttribute.h>
 #include <png.h>
-#include <tinyexr.h>
 #include <unistd.h>
 
 #define STB_IMAGE_IMPLEMENTATION
@@ -76,27 +82,74 @@ private:
     long headerBytes_ = 0;
 };
 
-// OpenEXR through tinyexr: rows are kept, and the file written at the end.
+// OpenEXR's output stream over the writer's temporary file.
+class ExrFileStream : public Imf::OStream {
+public:
+    ExrFileStream(std::FILE* file, const std::string& name) : Imf::OStream(name.c_str()), file_(file) {}
+    void write(const char c[], int n) override {
+        if (std::fwrite(c, 1, std::size_t(n), file_) != std::size_t(n))
+            throw ImageIOError("cannot write '" + std::string(fileName()) + "': " + errorText());
+    }
+    std::uint64_t tellp() override { return std::uint64_t(::ftello(file_)); }
+    void seekp(std::uint64_t pos) override {
+        if (::fseeko(file_, off_t(pos), SEEK_SET) != 0)
+            throw ImageIOError("cannot write '" + std::string(fileName()) + "': " + errorText());
+    }
+
+private:
+    std::FILE* file_;
+};
+
+// OpenEXR, 32-bit float R, G, B, ZIP, scan lines written as rows come. A
+// piece of a larger image has that image as its display window and its own
+// pixels as the data window; text goes into string attributes.
 class ExrWriter : public ImageWriter {
 public:
-    ExrWriter(std::string path, int width, int height) : ImageWriter(std::move(path), width, height) {
-        rgb_.reserve(std::size_t(width) * height * 3);
+    ExrWriter(std::string path, int width, int height, const ImageText& text, const ImagePlacement& placement)
+        : ImageWriter(std::move(path), width, height), stream_(file_, path_) {
+        const int fullWidth = placement.fullWidth > 0 ? placement.fullWidth : width;
+        const int fullHeight = placement.fullHeight > 0 ? placement.fullHeight : height;
+        origin_ = Imath::V2i(placement.x, placement.y);
+        Imf::Header header(Imath::Box2i(Imath::V2i(0, 0), Imath::V2i(fullWidth - 1, fullHeight - 1)),
+                           Imath::Box2i(origin_, origin_ + Imath::V2i(width - 1, height - 1)));
+        header.compression() = Imf::ZIP_COMPRESSION;
+        for (const char* channel : {"R", "G", "B"}) header.channels().insert(channel, Imf::Channel(Imf::FLOAT));
+        for (const auto& [key, value] : text) header.insert(key, Imf::StringAttribute(value));
+        guard([&] { output_ = std::make_unique<Imf::OutputFile>(stream_, header); });
     }
     void writeRows(const float* rgb, int rows) override {
-        rgb_.insert(rgb_.end(), rgb, rgb + std::size_t(width_) * 3 * rows);
+        guard([&] {
+            Imf::FrameBuffer frame;
+            const Imath::V2i first = origin_ + Imath::V2i(0, rowsWritten_);
+            const std::size_t pixelBytes = 3 * sizeof(float);
+            for (int c = 0; c < 3; ++c)
+                frame.insert(std::string(1, "RGB"[c]), Imf::Slice::Make(Imf::FLOAT, rgb + c, first, width_, rows,
+                                                                        pixelBytes, pixelBytes * width_));
+            output_->setFrameBuffer(frame);
+            output_->writePixels(rows);
+        });
         rowsWritten_ += rows;
     }
 
 private:
+    // The line offset table is written when the OutputFile closes.
     void finish() override {
-        const char* error = nullptr;
-        if (SaveEXR(rgb_.data(), width_, height_, 3, 0, temporary_.c_str(), &error) != TINYEXR_SUCCESS) {
-            const std::string message = error ? error : "unknown error";
-            FreeEXRErrorMessage(error);
-            throw ImageIOError("cannot write '" + path_ + "': " + message);
+        output_.reset();
+        if (std::ferror(file_)) throw ImageIOError("cannot write '" + path_ + "': " + errorText());
+    }
+    template <typename F>
+    void guard(F f) {
+        try {
+            f();
+        } catch (const ImageIOError&) {
+            throw;
+        } catch (const std::exception& e) {
+            throw ImageIOError("cannot write '" + path_ + "': " + e.what());
         }
     }
-    std::vector<float> rgb_;
+    ExrFileStream stream_;
+    std::unique_ptr<Imf::OutputFile> output_;
+    Imath::V2i origin_;
 };
 
 // PNG through libpng, row by row; text chunks name the scene and settings.
@@ -209,12 +262,12 @@ ImageWriter::~ImageWriter() {
 }
 
 std::unique_ptr<ImageWriter> ImageWriter::open(const std::string& path, int width, int height,
-                                               const ImageText& text) {
+                                               const ImageText& text, const ImagePlacement& placement) {
     switch (formatForPath(path)) {
     case ImageFormat::Png: return std::unique_ptr<ImageWriter>(new PngWriter(path, width, height, text));
     case ImageFormat::Ppm: return std::unique_ptr<ImageWriter>(new PpmWriter(path, width, height));
     case ImageFormat::Pfm: return std::unique_ptr<ImageWriter>(new PfmWriter(path, width, height));
-    case ImageFormat::Exr: return std::unique_ptr<ImageWriter>(new ExrWriter(path, width, height));
+    case ImageFormat::Exr: return std::unique_ptr<ImageWriter>(new ExrWriter(path, width, height, text, placement));
     }
     throw ImageIOError("unknown image format");
 }
@@ -238,28 +291,36 @@ void ImageWriter::commit() {
     committed_ = true;
 }
 
-void writeImage(const std::string& path, const Image& image, const ImageText& text) {
-    auto writer = ImageWriter::open(path, image.width, image.height, text);
+void writeImage(const std::string& path, const Image& image, const ImageText& text, const ImagePlacement& placement) {
+    auto writer = ImageWriter::open(path, image.width, image.height, text, placement);
     writer->writeRows(image.rgb.data(), image.height);
     writer->commit();
 }
 
-Image readImage(const std::string& path) {
+Image readImage(const std::string& path, ImagePlacement* placement) {
     if (formatForPath(path) == ImageFormat::Exr) {
-        float* rgba = nullptr;
-        int w = 0, h = 0;
-        const char* error = nullptr;
-        if (LoadEXR(&rgba, &w, &h, path.c_str(), &error) != TINYEXR_SUCCESS) {
-            const std::string message = error ? error : "unknown error";
-            FreeEXRErrorMessage(error);
-            throw ImageIOError("cannot read EXR '" + path + "': " + message);
+        try {
+            Imf::InputFile file(path.c_str());
+            const Imath::Box2i data = file.header().dataWindow();
+            const Imath::Box2i display = file.header().displayWindow();
+            Image image(data.max.x - data.min.x + 1, data.max.y - data.min.y + 1);
+            Imf::FrameBuffer frame;
+            const std::size_t pixelBytes = 3 * sizeof(float);
+            for (int c = 0; c < 3; ++c)  // a missing channel reads as 0
+                frame.insert(std::string(1, "RGB"[c]),
+                             Imf::Slice::Make(Imf::FLOAT, image.rgb.data() + c, data, pixelBytes,
+                                              pixelBytes * std::size_t(image.width)));
+            file.setFrameBuffer(frame);
+            file.readPixels(data.min.y, data.max.y);
+            if (placement)
+                *placement = {data.min.x - display.min.x, data.min.y - display.min.y,
+                              display.max.x - display.min.x + 1, display.max.y - display.min.y + 1, true};
+            return image;
+        } catch (const std::exception& e) {
+            throw ImageIOError("cannot read EXR '" + path + "': " + e.what());
         }
-        Image image(w, h);
-        for (std::size_t p = 0; p < std::size_t(w) * h; ++p)
-            for (int k = 0; k < 3; ++k) image.rgb[p * 3 + k] = rgba[p * 4 + k];
-        std::free(rgba);
-        return image;
     }
+    if (placement) *placement = {};
     std::ifstream in(path, std::ios::binary);
     if (!in) throw ImageIOError("cannot open '" + path + "': " + errorText());
     std::ostringstream buffer;

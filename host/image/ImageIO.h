@@ -1,7 +1,6 @@
 // Image files: PNG (8-bit), PPM P6 (8-bit), PFM and OpenEXR (float,
-// unclamped; EXR through tinyexr, 32-bit float, ZIP), chosen by extension.
-// EXR is the one format written whole at the end: its memory is 12 bytes a
-// pixel. Writing streams rows (an image of any size is written with
+// unclamped; EXR through the OpenEXR library, 32-bit float, ZIP), chosen by
+// extension. Writing streams rows (an image of any size is written with
 // bounded memory) into a temporary file beside the target, renamed over it
 // only on commit(), so a failed or interrupted write never leaves a partial or
 // clobbered file.
@@ -40,12 +39,21 @@ void checkWritable(const std::string& path);
 // Text stored with the image where the format allows (PNG tEXt chunks).
 using ImageText = std::vector<std::pair<std::string, std::string>>;
 
+// Where an image lies within a larger one (a piece rendered with --region):
+// its top-left pixel there and the larger image's size (0: the image's own).
+// EXR keeps it as its data and display windows; the other formats do not.
+struct ImagePlacement {
+    int x = 0, y = 0;
+    int fullWidth = 0, fullHeight = 0;
+    bool stored = false;  // read from the file (EXR)
+};
+
 // Rows of width × 3 floats, top to bottom, in one or more calls.
 class ImageWriter {
 public:
     // Opens a temporary file beside `path`. Throws ImageIOError.
     static std::unique_ptr<ImageWriter> open(const std::string& path, int width, int height,
-                                             const ImageText& text = {});
+                                             const ImageText& text = {}, const ImagePlacement& placement = {});
     virtual ~ImageWriter();
     // The next `rows` rows (rgb floats, width * 3 per row).
     virtual void writeRows(const float* rgb, int rows) = 0;
@@ -62,7 +70,9 @@ protected:
     bool committed_ = false;
 };
 
-void writeImage(const std::string& path, const Image& image, const ImageText& text = {});
-Image readImage(const std::string& path);
+void writeImage(const std::string& path, const Image& image, const ImageText& text = {},
+                const ImagePlacement& placement = {});
+// `placement`, if given, receives where the file says the image lies.
+Image readImage(const std::string& path, ImagePlacement* placement = nullptr);
 
 }  // namespace snell
