@@ -36,7 +36,8 @@ ImageFormat formatForPath(const std::string& path);
 // a writable directory. Throws ImageIOError with the reason.
 void checkWritable(const std::string& path);
 
-// Text stored with the image where the format allows (PNG tEXt chunks).
+// Text stored with the image where the format allows (PNG tEXt chunks, EXR
+// string attributes).
 using ImageText = std::vector<std::pair<std::string, std::string>>;
 
 // Where an image lies within a larger one (a piece rendered with --region):
