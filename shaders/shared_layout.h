@@ -30,7 +30,7 @@ using uint = std::uint32_t;
 #define SNELL_WORKGROUP_SIZE 64
 
 // Descriptor set 0. Storage buffers: what the shader writes.
-#define SNELL_BINDING_OUTPUT 0         // vec4 pixels[]: the tile, row-major
+#define SNELL_BINDING_OUTPUT 0         // OutputPixel pixels[]: the tile, row-major
 #define SNELL_BINDING_COUNTERS 1
 #define SNELL_BINDING_SLOT_STATES 2
 #define SNELL_BINDING_RAY_STACK 3
@@ -75,7 +75,8 @@ using uint = std::uint32_t;
 #define SNELL_SPEC_BVH_DEPTH 12
 #define SNELL_SPEC_ELLIPSOID_MASK 13
 #define SNELL_SPEC_SPHERES_IN_BLOCK 14
-#define SNELL_SPEC_COUNT 15
+#define SNELL_SPEC_FRONTIER 15
+#define SNELL_SPEC_COUNT 16
 
 // Slots of the counters buffer: rays by kind, then per-dispatch bookkeeping.
 #define SNELL_COUNTER_PRIMARY 0
@@ -87,9 +88,8 @@ using uint = std::uint32_t;
 #define SNELL_COUNTER_LOOP_LIMIT 5  // subgroups that may have hit the driver's loop limit
 #define SNELL_COUNTER_DEEPEST 6     // the deepest ray traced (atomicMax)
 #define SNELL_COUNTER_OVERFLOW 7    // rays dropped because an invocation's ray stack was full
-#define SNELL_COUNTER_OVER_BUDGET 8 // pixels with a sample whose tree reached the tree budget
-#define SNELL_COUNTER_CANCEL 9      // set by the host while a dispatch runs: take no new pixel
-#define SNELL_COUNTER_COUNT 10
+#define SNELL_COUNTER_CANCEL 8      // set by the host while a dispatch runs: take no new pixel
+#define SNELL_COUNTER_COUNT 9
 
 // Mesa's llvmpipe before 24 (lavapipe in Debian 12's Mesa 22.3) ends every
 // loop of a shader once one SIMD row has run 65535 loop iterations in total in
@@ -161,20 +161,40 @@ struct BvhNode {
 #define SNELL_BVH_MAX_LEAF 4
 #define SNELL_BVH_INNER 0xffffffffu
 
-// An invocation's progress between dispatches (one per invocation).
+// An invocation's progress between dispatches (one per invocation). A pixel
+// is traced in steps of falling cut-off: a step traces on from the rays the
+// last one left under its cut-off (the frontier, a ring of SNELL_SPEC_FRONTIER
+// entries after the invocation's ray stack), so the steps together trace the
+// very tree of one pass at the last cut-off (render/RenderRequest.h).
 struct SlotState {
-    vec4 sum;        // rgb: the current pixel's finished samples and the current one so far
-    vec4 dropped;    // rgb: the weight of its rays not traced (render/Truncation.h); w: its cut-off
-    vec4 lower;      // rgb: the pixel's best lower and upper bounds over its attempts so far
+    vec4 sum;        // rgb: the pixel's sum over its samples so far
+    vec4 deferred;   // rgb: the weight of the rays waiting in the frontier
+    vec4 lost;       // rgb: the weight of rays lost for good (depth limit, floor, tree budget, full stack)
+    vec4 lower;      // rgb: the pixel's best lower and upper bounds over its steps so far
     vec4 upper;      //      (render/Truncation.h, PixelEstimate)
+    vec4 settled;    // rgb: its colour after the last step, clamped; w: the weight it had not traced then, in
+                     // channels under 1, per sample (render/Truncation.h, ErrorEstimate)
+    vec4 cutOff;     // x: this step's cut-off; y: the heaviest ray it deferred; z, w: how far the
+                     // last step and the one before moved the colour
     uint pixel;      // the pixel of the tile in progress (row-major); ≥ tile size: done
     uint started;    // samples of it started
     uint pending;    // rays waiting on this invocation's stack
     uint finished;   // pixels finished so far in this tile (read by the host for progress)
-    uint treeRays;   // rays the current sample's tree has traced
-    uint overBudget; // 1: a sample of the current pixel reached the tree budget
+    uint treeRays;   // rays the pixel's trees have traced
+    uint overBudget; // 1: they reached the tree budget
     uint rays;       // rays traced so far in this tile (read by the host for progress)
-    uint pad0;
+    uint steps;      // steps of the current pixel finished
+    uint frontierHead;   // the frontier's first entry
+    uint frontierCount;  // its entries
+    uint frontierOld;    // of those, the ones the last step left, still to trace in this one
+    uint amplified;      // 1: a hit of its trees gained weight (ks + kt > 1 where the ray carried light)
+};
+
+// What the shader writes for each pixel of a tile.
+struct OutputPixel {
+    vec4 colour;      // rgb: the colour (unclamped); a: its truncation bound, negative where not finite
+    vec4 truncation;  // x: the estimated error where it stopped on one (render/Truncation.h), else −1;
+                      // y: 1 where the tree budget stopped it; z: 1 where it ended over the tolerance
 };
 
 // A ray waiting to be traced (SPEC §4 ray tree, depth first). Its medium stack
@@ -203,6 +223,9 @@ struct FrameParams {
     vec4 ambient;       // rgb ambient, w = minimum ray weight (with a tolerance: the lowest cut-off tried)
     vec4 radiance;      // rgb: the radiance bound R (render/Truncation.h), +inf where light need not decay;
                         // w: the tolerance on each pixel's truncation bound, 0: none
+    vec4 localRadiance; // rgb: the most light one hit or miss returns, its children aside (RadianceBound::local);
+                        // w: the estimated error within which a pixel whose trees gained weight may stop
+                        // (render/Truncation.h, kAmplifiedEstimate)
     uint imageWidth;
     uint imageHeight;
     uint supersample;
@@ -212,9 +235,9 @@ struct FrameParams {
     uint bvhNodeCount;
     uint firstSample;   // trace sub-pixel samples firstSample .. firstSample + sampleCount − 1
     uint sampleCount;   // of the supersample² grid (row-major), and output their mean
-    uint treeBudget;    // the most rays one sample's tree may trace; 0: no limit
+    uint treeBudget;    // the most rays a pixel's trees may trace, per sample; 0: no limit
+    uint estimate;      // 1: an unbounded pixel stops on its estimated error (TraceSettings::estimate)
     uint pad0;
-    uint pad1;
 };
 
 // Push constants: the tile of the image this dispatch covers, and whether it

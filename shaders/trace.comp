@@ -48,13 +48,16 @@ layout(constant_id = SNELL_SPEC_AMPLIFYING) const bool AMPLIFYING = false;
 // Loop iterations a subgroup may spend in one dispatch before its invocations
 // suspend; 0: no limit (drivers without llvmpipe's old loop limiter).
 layout(constant_id = SNELL_SPEC_LOOP_BUDGET) const uint LOOP_BUDGET = 0u;
+// Entries of an invocation's frontier: the rays a step leaves under its
+// cut-off, which the next step traces on (0: a fixed tree, nothing deferred).
+layout(constant_id = SNELL_SPEC_FRONTIER) const uint FRONTIER = 0u;
 // Off (a preview inspection switch): no shadow rays, every light is seen.
 layout(constant_id = SNELL_SPEC_SHADOWS) const bool SHADOWS = true;
 
 // What the shader writes: the tile's pixels, row-major (a buffer: on lavapipe
 // an imageStore in a loop costs 13x a buffer store; rgb the colour, a the
 // pixel's truncation bound), and its own bookkeeping.
-layout(set = 0, binding = SNELL_BINDING_OUTPUT, std430) writeonly buffer OutputBlock { vec4 outputPixels[]; };
+layout(set = 0, binding = SNELL_BINDING_OUTPUT, std430) writeonly buffer OutputBlock { OutputPixel outputPixels[]; };
 layout(set = 0, binding = SNELL_BINDING_COUNTERS, std430) buffer CounterBlock { uint counters[]; };
 layout(set = 0, binding = SNELL_BINDING_SLOT_STATES, std430) buffer SlotStateBlock { SlotState slotStates[]; };
 layout(set = 0, binding = SNELL_BINDING_RAY_STACK, std430) buffer RayStackBlock { PendingRay rayStack[]; };
@@ -280,7 +283,7 @@ bool occluded(rvec3 origin, rvec3 dir, real distance, uint fromSphere, uint star
 // it heads into that sphere, and its medium stack (innermost last).
 
 // cutOff: that of the pixel in hand, the minimum weight or, under a
-// tolerance, the one its current attempt uses (SlotState.dropped.w). (The
+// tolerance, the one its current step uses (SlotState.cutOff.x). (The
 // per-pixel values live in main's locals and are passed down: Mesa 22.3's
 // llvmpipe keeps memory for every dispatch of a shader with such private
 // globals, tests/soak_test.sh.)
@@ -338,8 +341,12 @@ struct Hit {
 
 float etaOfSphere(uint sphere) { return materialKt(sphereMaterial(sphere)).w; }
 
-void pushRay(uint slot, inout uint pending, Ray r) {
-    uint entry = slot * RAY_STACK + pending;
+// An invocation's entries in the ray and media buffers: its stack of
+// RAY_STACK entries, then its frontier of FRONTIER.
+uint stackEntry(uint slot, uint k) { return slot * (RAY_STACK + FRONTIER) + k; }
+uint frontierEntry(uint slot, uint k) { return slot * (RAY_STACK + FRONTIER) + RAY_STACK + k % max(FRONTIER, 1u); }
+
+void storeRay(uint entry, Ray r) {
 #ifdef SNELL_FP64
     vec3 origin, originLow, dir, dirLow;
     splitDouble(r.origin, origin, originLow);
@@ -353,18 +360,49 @@ void pushRay(uint slot, inout uint pending, Ray r) {
                                  (r.inward ? 1u : 0u) | (r.mediaCount << 1), r.resumeShading);
     [[unroll]] for (int k = 0; k < MAX_MEDIA; ++k)
         if (uint(k) < r.mediaCount) mediaStack[entry * uint(MAX_MEDIA) + uint(k)] = media[k];
-    pending++;
 }
 
-Ray popRay(uint slot, inout uint pending) {
-    pending--;
-    uint entry = slot * RAY_STACK + pending;
+Ray loadRay(uint entry) {
     PendingRay p = rayStack[entry];
     uint mediaCount = p.flags >> 1;
     [[unroll]] for (int k = 0; k < MAX_MEDIA; ++k)
         if (uint(k) < mediaCount) media[k] = mediaStack[entry * uint(MAX_MEDIA) + uint(k)];
     return Ray(WIDE(p.origin, rayStackLow[entry].origin).xyz, WIDE(p.direction, rayStackLow[entry].direction).xyz,
                p.weight.rgb, p.depth, p.fromSphere, (p.flags & 1u) != 0u, mediaCount, p.resumeShading);
+}
+
+void pushRay(uint slot, inout uint pending, Ray r) {
+    storeRay(stackEntry(slot, pending), r);
+    pending++;
+}
+
+Ray popRay(uint slot, inout uint pending) {
+    pending--;
+    return loadRay(stackEntry(slot, pending));
+}
+
+// A ray under the cut-off (its medium stack in `media`) waits in the frontier
+// for the pixel's next step; one under the floor is lost for good, but in an
+// amplifying scene, where a pixel may need to go below it (main), it waits.
+void deferRay(uint slot, inout SlotState state, Ray r) {
+    float m = max(r.weight.r, max(r.weight.g, r.weight.b));
+    if (!(m > 0.0)) return;
+    if (FRONTIER > 0u && state.frontierCount < FRONTIER && (AMPLIFYING || m >= frame.ambient.w)) {
+        storeRay(frontierEntry(slot, state.frontierHead + state.frontierCount), r);
+        state.frontierCount++;
+        state.deferred.rgb += r.weight;
+        state.cutOff.y = max(state.cutOff.y, m);
+    } else {
+        state.lost.rgb += r.weight;
+    }
+}
+
+// The cut-off that decides whether a ray is traced now: the step's, while the
+// frontier has room for what it leaves; the floor once it is full (the ray is
+// traced now rather than lost: the tree only grows, and no step traces any
+// ray twice).
+float tracingCutOff(SlotState state, float cutOff) {
+    return FRONTIER > 0u && state.frontierCount >= FRONTIER ? frame.ambient.w : cutOff;
 }
 
 // 1–2. The closest hit of ray r: on a miss the background is added to the
@@ -419,36 +457,74 @@ vec3 shadeLight(uint j, Hit h, rvec3 v, inout uint shadowRays) {
     return lightColour(j) * (h.kd.rgb * nl + h.ks.rgb * specular);
 }
 
-// What an attempt at a pixel proves of its exact colour: its colour is a lower
-// bound and its colour plus its dropped weight times the radiance bound an
-// upper bound; the pixel keeps the best of each (render/Truncation.h,
+// What a step of a pixel proves of its exact colour: its colour is a lower
+// bound and its colour plus the weight it has not traced times the radiance
+// bound an upper bound; the pixel keeps the best of each (render/Truncation.h,
 // PixelEstimate, its twin). Returns the bound on the clamped colour.
-float addAttempt(inout SlotState state, vec3 droppedWeight, float samples, out bool unbounded) {
+float addStep(inout SlotState state, float samples, out bool unbounded) {
     vec3 value = state.sum.rgb / samples;
+    vec3 notTraced = state.lost.rgb + state.deferred.rgb;
     state.lower.rgb = max(state.lower.rgb, value);
-    state.upper.rgb = min(state.upper.rgb, value + weighted(droppedWeight, frame.radiance.rgb) / samples);
+    state.upper.rgb = min(state.upper.rgb, value + weighted(notTraced, frame.radiance.rgb) / samples);
     vec3 gap = min(state.upper.rgb, vec3(1.0)) - min(state.lower.rgb, vec3(1.0));
     unbounded = any(bvec3(uvec3(greaterThan(state.upper.rgb, vec3(3.0e38))) & uvec3(lessThan(state.lower.rgb, vec3(1.0)))));
     return max(0.0, max(gap.r, max(gap.g, gap.b)));
 }
 
+// The estimated error of a pixel that cannot be certified, from how far its
+// last steps moved its colour and how the light its untraced weight may carry
+// changed: a geometric tail (render/Truncation.h, ErrorEstimate, its twin).
+// +inf while unknown or not shrinking.
+float estimateError(inout SlotState state, float samples) {
+    vec3 colour = min(state.lower.rgb, vec3(1.0));
+    vec3 open = mix(weighted(state.deferred.rgb, frame.localRadiance.rgb) / samples, vec3(0.0),
+                    greaterThanEqual(colour, vec3(1.0)));
+    float weight = max(open.r, max(open.g, open.b));
+    if (state.steps > 0u) {
+        vec3 moved = abs(colour - state.settled.rgb);
+        state.cutOff.w = state.cutOff.z;
+        state.cutOff.z = max(moved.r, max(moved.g, moved.b));
+    }
+    float previousWeight = state.steps > 0u ? state.settled.w : INFINITY;
+    state.settled = vec4(colour, weight);
+    state.steps++;
+    if (state.steps < 3u || !(weight < previousWeight)) return INFINITY;
+    float change = state.cutOff.z;
+    float rho = max(change / state.cutOff.w, weight / previousWeight);
+    if (!(rho < 1.0) && change > 0.0) return INFINITY;
+    return max(weight, change > 0.0 ? change / (1.0 - rho) : 0.0);
+}
+
+// The rung of the cut-off ladder at or below w > 0: w with its mantissa
+// cleared, a power of two (render/RenderRequest.h, cutOffRung).
+float cutOffRung(float w) { return uintBitsToFloat(floatBitsToUint(w) & 0x7f800000u); }
+
 // 4–5. The children of ray r at hit h: reflection (keeps the medium stack) and
 // refraction (SPEC §4.5). On return r is the child to trace next (hasRay), the
 // other child having been pushed on the stack; refraction is traced first, as
-// in the CPU reference.
-// `dropped` gathers the weight of the children not traced (render/Truncation.h).
-void spawnChildren(uint slot, inout uint pending, inout Ray r, vec3 weight, Hit h, float cutOff, inout vec3 dropped,
+// in the CPU reference. A child under the cut-off waits in the frontier
+// (deferRay); weight the depth limit stops is lost (render/Truncation.h).
+void spawnChildren(uint slot, inout SlotState state, inout Ray r, vec3 weight, Hit h, float cutOff,
                    out bool hasRay) {
     hasRay = false;
     vec3 reflectedGain = HAS_REFLECTION ? h.ks.rgb : vec3(0.0);
     if (r.depth >= frame.maxDepth) {
-        dropped += weighted(weight, reflectedGain + (HAS_REFRACTION ? h.kt.rgb : vec3(0.0)));
+        state.lost.rgb += weighted(weight, reflectedGain + (HAS_REFRACTION ? h.kt.rgb : vec3(0.0)));
         return;
     }
     rvec3 d = r.dir;
     rvec3 n = h.normal;
+    // Light carried into a material of ks + kt > 1 (SPEC §4 amplifying
+    // materials) can grow: an orbit of total internal reflection repeats its
+    // angle for ever, and a path of tiny weight that enters one grows until
+    // its channel saturates. The pixel's series may diverge behind steps that
+    // seem to settle, so its estimated error must be within kAmplifiedEstimate
+    // (render/Truncation.h; main).
+    if (AMPLIFYING && any(bvec3(uvec3(greaterThan(reflectedGain + (HAS_REFRACTION ? h.kt.rgb : vec3(0.0)), vec3(1.0))) &
+                                uvec3(greaterThan(weight, vec3(0.0))))))
+        state.amplified = 1u;
     vec3 reflectedWeight = min(weighted(weight, reflectedGain), vec3(MAX_WEIGHT));
-    bool refracts = false;
+    bool transmits = false;  // a refracted ray exists (no total internal reflection)
     rvec3 refracted = rvec3(0.0);
     vec3 transmittedWeight = vec3(0.0);
     uint removeAt = r.mediaCount;  // leaving: where this sphere is in the stack
@@ -479,20 +555,20 @@ void spawnChildren(uint slot, inout uint pending, inout Ray r, vec3 weight, Hit 
             // Total internal reflection is the reflected ray in the same medium:
             // one ray carries both weights.
             reflectedWeight = min(reflectedWeight + transmittedWeight, vec3(MAX_WEIGHT));
-        } else if (worthTracing(transmittedWeight, cutOff)) {
-            refracts = true;
-            refracted = normalize(eta * d + (eta * c - sqrt(k)) * n);
         } else {
-            dropped += transmittedWeight;
+            transmits = true;
+            refracted = normalize(eta * d + (eta * c - sqrt(k)) * n);
         }
     }
-    bool reflects = (HAS_REFLECTION || HAS_REFRACTION) && worthTracing(reflectedWeight, cutOff);
-    if (!reflects) dropped += reflectedWeight;
+    float cut = tracingCutOff(state, cutOff);
+    bool reflects = (HAS_REFLECTION || HAS_REFRACTION) && worthTracing(reflectedWeight, cut);
+    bool refracts = transmits && worthTracing(transmittedWeight, cut);
     Ray reflectedRay = Ray(h.point, d - 2.0 * dot(d, n) * n, reflectedWeight, r.depth + 1u, h.sphere, !h.fromOutside,
                            r.mediaCount, 0u);
+    if (!reflects && (HAS_REFLECTION || HAS_REFRACTION)) deferRay(slot, state, reflectedRay);
     if (reflects && COUNT_RAYS) countedRays[SNELL_COUNTER_REFLECTED]++;
     if (refracts && COUNT_RAYS) countedRays[SNELL_COUNTER_REFRACTED]++;
-    if (!refracts) {
+    if (!transmits) {
         r = reflectedRay;
         hasRay = reflects;
         return;
@@ -501,28 +577,20 @@ void spawnChildren(uint slot, inout uint pending, inout Ray r, vec3 weight, Hit 
     // stack, so each waiting ray at least halves (ks + kt <= 1) the weight of
     // the path below it, and the stack needs no more than log(cut-off) / log(q)
     // entries however deep the tree (host/gpu/ComputeRenderer.cpp sizes it).
-    bool refractedWaits = false;
-    if (reflects) {
-        // In an amplifying scene (where the stack is sized by depth anyway)
-        // the heavier goes on instead: under a tree budget the weightiest
-        // rays are traced first, which is what saturates a diverging channel.
-        refractedWaits = (max(transmittedWeight.r, max(transmittedWeight.g, transmittedWeight.b)) >
-                          max(reflectedWeight.r, max(reflectedWeight.g, reflectedWeight.b))) != AMPLIFYING;
-        // One entry stays free for the ray in hand should the invocation suspend.
-        if (pending + 1u >= RAY_STACK) {
-            // Full (only an amplifying tree can fill it): the child that would
-            // wait is dropped, its weight counted in the bound, and the host
-            // says so.
-            dropped += refractedWaits ? transmittedWeight : reflectedWeight;
-            atomicAdd(counters[SNELL_COUNTER_OVERFLOW], 1u);
-            if (refractedWaits) {
-                r = reflectedRay;
-                hasRay = true;
-                return;
-            }
-        } else if (!refractedWaits) {
-            pushRay(slot, pending, reflectedRay);  // with the parent's media, still current
-        }
+    // In an amplifying scene (where the stack is sized by depth anyway) the
+    // heavier goes on instead: under a tree budget the weightiest rays are
+    // traced first, which is what saturates a diverging channel.
+    bool both = reflects && refracts;
+    bool refractedWaits = both && (max(transmittedWeight.r, max(transmittedWeight.g, transmittedWeight.b)) >
+                                   max(reflectedWeight.r, max(reflectedWeight.g, reflectedWeight.b))) != AMPLIFYING;
+    // One entry stays free for the ray in hand should the invocation suspend.
+    // Full (only an amplifying tree can fill it): the child that would wait is
+    // lost, its weight counted in the bound, and the host says so.
+    bool stackFull = state.pending + 1u >= RAY_STACK;
+    if (both && stackFull) atomicAdd(counters[SNELL_COUNTER_OVERFLOW], 1u);
+    if (both && !refractedWaits) {
+        if (stackFull) state.lost.rgb += reflectedWeight;
+        else pushRay(slot, state.pending, reflectedRay);  // with the parent's media, still current
     }
     // The refracted ray's medium stack replaces the parent's (kept when the
     // reflected ray goes on with it).
@@ -542,13 +610,19 @@ void spawnChildren(uint slot, inout uint pending, inout Ray r, vec3 weight, Hit 
             if (uint(k) >= removeAt && uint(k) + 1u < count) media[k] = media[k + 1];
         count--;
     }
-    r = Ray(h.point, refracted, transmittedWeight, r.depth + 1u, h.sphere, h.fromOutside, count, 0u);
-    hasRay = true;
-    if (refractedWaits && pending + 1u < RAY_STACK) {
-        pushRay(slot, pending, r);
-        [[unroll]] for (int k = 0; k < MAX_MEDIA; ++k) media[k] = parentMedia[k];
-        r = reflectedRay;
+    Ray refractedRay = Ray(h.point, refracted, transmittedWeight, r.depth + 1u, h.sphere, h.fromOutside, count, 0u);
+    if (refracts && !refractedWaits) {
+        r = refractedRay;  // traced next, with its medium stack
+        hasRay = true;
+        return;
     }
+    if (!refracts) deferRay(slot, state, refractedRay);
+    else if (stackFull) state.lost.rgb += transmittedWeight;
+    else pushRay(slot, state.pending, refractedRay);
+    // The reflected ray goes on (if it is traced at all), with the parent's media.
+    [[unroll]] for (int k = 0; k < MAX_MEDIA; ++k) media[k] = parentMedia[k];
+    r = reflectedRay;
+    hasRay = reflects;
 }
 
 // SPEC §3: sub-pixel sample k of pixel p: the ray through
@@ -578,9 +652,8 @@ void main() {
     }
 
     // This invocation's progress: its current pixel, that pixel's sum, and the
-    // rays on its stack. Fresh, or resumed from the last dispatch.
-    // Under a tolerance each pixel starts at the tolerance over the largest
-    // finite radiance bound (as CpuRenderer::renderPixel does).
+    // rays on its stack and in its frontier. Fresh, or resumed from the last
+    // dispatch.
     // Mesa 22.3's lavapipe specialises a shader on values it reads from
     // uniforms with constant offsets where it judges that worthwhile
     // (lvp_inline_uniforms); for this kernel it judged so because of the
@@ -590,20 +663,23 @@ void main() {
     // tolerance out of that analysis; tests/soak_test.sh watches for it.
     uint opaqueZero = gl_NumWorkGroups.y - 1u;
     float tolerance = frame.radiance.w + float(opaqueZero);
-    float largestRadiance = 1.0;
-    [[unroll]] for (int c = 0; c < 3; ++c)
-        if (!isinf(frame.radiance[c])) largestRadiance = max(largestRadiance, frame.radiance[c]);
-    float firstCutOff = tolerance > 0.0 ? max(frame.ambient.w, tolerance / (4.0 * largestRadiance)) : frame.ambient.w;
-    SlotState state = SlotState(vec4(0.0), vec4(0.0, 0.0, 0.0, firstCutOff), vec4(0.0), vec4(INFINITY), slot, 0u, 0u,
-                                0u, 0u, 0u, 0u, 0u);
+    float floorCutOff = frame.ambient.w;
+    // Under a tolerance each pixel starts on the ladder's first rung, 1/4,
+    // whatever the tolerance (render/RenderRequest.h, kFirstRung).
+    float firstCutOff = tolerance > 0.0 ? max(floorCutOff, 0.25) : floorCutOff;
+    const SlotState freshPixel = SlotState(vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0), vec4(INFINITY), vec4(0.0),
+                                           vec4(firstCutOff, 0.0, INFINITY, INFINITY), 0u, 0u, 0u, 0u, 0u, 0u, 0u,
+                                           0u, 0u, 0u, 0u, 0u);
+    SlotState state = freshPixel;
+    state.pixel = slot;
     if (tile.resume != 0u) state = slotStates[slot];
-    vec3 dropped = state.dropped.rgb;  // the weight of this pixel's rays not traced
-    float cutOff = state.dropped.w;
+    float cutOff = state.cutOff.x;
     uint shadowRays = 0u;               // cast in this dispatch (for SlotState.rays)
     uint deepest = 0u;
     bool done = state.pixel >= tilePixels;
     uvec2 pixel = uvec2(state.pixel % tile.width, state.pixel / tile.width);  // within the tile
     uint samples = frame.sampleCount;
+    uint pixelBudget = frame.treeBudget * samples;  // 0: none
     // SPEC §4 amplifying materials: a channel whose pixel sum has reached 1
     // (times the samples, as the sum is of samples) is final in 8 bits.
     float saturation = AMPLIFYING ? float(samples) : 3.0e38;
@@ -638,37 +714,61 @@ void main() {
             if (state.pending > 0u) {
                 ray = popRay(slot, state.pending);
                 hasRay = true;
+            } else if (state.frontierOld > 0u) {
+                // This step goes on from a ray the last one left.
+                ray = loadRay(frontierEntry(slot, state.frontierHead));
+                state.frontierHead = (state.frontierHead + 1u) % max(FRONTIER, 1u);
+                state.frontierCount--;
+                state.frontierOld--;
+                hasRay = true;
             } else if (state.started == samples) {
-                // The pixel is finished: SPEC §3 mean (clamped on output) and
-                // its truncation bound, negative where it is not finite.
+                // A step of the pixel is finished: what it proves (SPEC §3 mean,
+                // clamped on output), and whether a lower cut-off is worth it.
                 bool unbounded;
-                float bound = addAttempt(state, dropped, float(samples), unbounded);
-                if (tolerance > 0.0 && bound > tolerance && cutOff > frame.ambient.w) {
-                    // Over the tolerance: the pixel again, with a 16x lower cut-off.
-                    cutOff = max(frame.ambient.w, cutOff / 16.0);
+                float bound = addStep(state, float(samples), unbounded);
+                float estimate = estimateError(state, float(samples));
+                bool certified = bound <= tolerance;
+                bool settled = frame.estimate != 0u && unbounded && estimate <= tolerance &&
+                               (state.amplified == 0u || estimate <= frame.localRadiance.w);
+                // The next rung: the highest that traces a ray this step left,
+                // not under the floor; but a pixel whose trees gained weight
+                // goes on below it, until its diverging channels saturate or
+                // its trees reach the budget (SPEC §4 amplifying materials; as
+                // CpuRenderer::renderPixel does).
+                float heaviest = state.cutOff.y;
+                bool belowFloor = AMPLIFYING && unbounded && state.amplified != 0u && pixelBudget != 0u;
+                // (Below the floor it steps 16x at a time: such a pixel goes on
+                // to the budget or saturation anyway, and fewer steps cost less.)
+                float next = belowFloor ? cutOffRung(heaviest) / 16.0 : max(floorCutOff, cutOffRung(heaviest));
+                if (tolerance > 0.0 && !certified && !settled && heaviest > 0.0 && next > 0.0 && next <= heaviest &&
+                    state.overBudget == 0u) {
+                    cutOff = next;
+                    state.deferred.rgb = vec3(0.0);
+                    state.cutOff.y = 0.0;
+                    state.frontierOld = state.frontierCount;
                 } else {
-                    outputPixels[state.pixel] = vec4(state.lower.rgb, unbounded ? -bound : bound);
-                    state.lower = vec4(0.0);
-                    state.upper = vec4(INFINITY);
-                    if (state.overBudget != 0u) atomicAdd(counters[SNELL_COUNTER_OVER_BUDGET], 1u);
-                    state.finished++;
-                    slotStates[slot].finished = state.finished;
-                    slotStates[slot].rays = state.rays + shadowRays;
-                    state.pixel += slots;
+                    bool overTolerance = tolerance > 0.0 && !certified && !settled;
+                    outputPixels[state.pixel] = OutputPixel(
+                        vec4(state.lower.rgb, unbounded ? -bound : bound),
+                        vec4(settled ? estimate : -1.0, float(state.overBudget), overTolerance ? 1.0 : 0.0, 0.0));
+                    uint finished = state.finished + 1u;
+                    uint rays = state.rays;
+                    uint nextPixel = state.pixel + slots;
+                    state = freshPixel;
+                    state.finished = finished;
+                    state.rays = rays;
+                    state.pixel = nextPixel;
+                    slotStates[slot].finished = finished;
+                    slotStates[slot].rays = rays + shadowRays;
                     pixel += uvec2(tile.stepX, tile.stepY);
                     if (pixel.x >= tile.width) pixel += uvec2(-tile.width, 1u);
                     cutOff = firstCutOff;
                     done = state.pixel >= tilePixels;
                 }
-                state.started = 0u;
-                state.sum = vec4(0.0);
-                state.overBudget = 0u;
-                dropped = vec3(0.0);
             }
-            if (!done && !hasRay) {
+            if (!done && !hasRay && state.started < samples) {
                 ray = cameraRay(pixel + uvec2(tile.originX, tile.originY), frame.firstSample + state.started);
                 state.started++;
-                state.treeRays = 0u;
                 hasRay = true;
                 if (COUNT_RAYS) countedRays[SNELL_COUNTER_PRIMARY]++;
             }
@@ -680,25 +780,28 @@ void main() {
         bool shading = false;
         if (hasRay) {
             weight = ray.weight;
-            // (A ray resuming its shading keeps the weight it started with.)
-            if (AMPLIFYING && ray.resumeShading == 0u)
+            bool resuming = ray.resumeShading != 0u;  // it keeps the weight it started with
+            if (AMPLIFYING && !resuming)
                 weight = mix(weight, vec3(0.0), greaterThanEqual(state.sum.rgb, vec3(saturation)));
-            // A sample's tree past the budget: the rest of it is dropped.
-            bool overBudget = frame.treeBudget != 0u && state.treeRays >= frame.treeBudget && ray.resumeShading == 0u;
-            if (overBudget && worthTracing(weight, cutOff)) state.overBudget = 1u;
-            if (worthTracing(weight, cutOff) && !overBudget) {
-                if (ray.resumeShading == 0u) {
+            // The pixel's trees past the budget: the rest of them is lost.
+            bool overBudget = pixelBudget != 0u && state.treeRays >= pixelBudget && !resuming;
+            if (!resuming && !worthTracing(weight, tracingCutOff(state, cutOff))) {
+                ray.weight = weight;
+                deferRay(slot, state, ray);
+            } else if (overBudget) {
+                state.overBudget = 1u;
+                state.lost.rgb += weight;
+            } else {
+                if (!resuming) {
                     state.treeRays++;
                     state.rays++;
                 }
                 vec3 sum = state.sum.rgb;
                 shading = findHit(ray, weight, sum, h);
                 // The ambient part once, not again when shading resumes.
-                if (shading && ray.resumeShading == 0u) sum += weighted(weight, frame.ambient.rgb * h.kd.rgb);
+                if (shading && !resuming) sum += weighted(weight, frame.ambient.rgb * h.kd.rgb);
                 state.sum.rgb = sum;
                 deepest = max(deepest, ray.depth);
-            } else {
-                dropped += weight;
             }
             hasRay = shading;
         }
@@ -730,7 +833,7 @@ void main() {
             }
             if (suspended) break;
         }
-        if (shading) spawnChildren(slot, state.pending, ray, weight, h, cutOff, dropped, hasRay);
+        if (shading) spawnChildren(slot, state, ray, weight, h, cutOff, hasRay);
     }
 
     if (suspended) {
@@ -740,7 +843,7 @@ void main() {
     }
     // Under a loop budget the next dispatch resumes every invocation, those
     // whose subgroup finished included: each leaves its state, done or not.
-    state.dropped = vec4(dropped, cutOff);
+    state.cutOff.x = cutOff;
     state.rays += shadowRays;
     if (LOOP_BUDGET != 0u) slotStates[slot] = state;
     if (deepest > 0u) atomicMax(counters[SNELL_COUNTER_DEEPEST], deepest);

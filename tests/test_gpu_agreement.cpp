@@ -5,6 +5,7 @@
 // written to build/test-artifacts/ and named in the message.
 #include <chrono>
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -30,6 +31,8 @@ constexpr int kBadThreshold = 3;
 // The reference certifies a pixel when its truncation bound (render/Truncation.h)
 // is within half an 8-bit step: only there is the exact image known.
 constexpr double kCertified = 0.5 / 255.0;
+// At most this fraction of a scene's pixels may be left out as ill-conditioned.
+constexpr double kMaxIllConditioned = 0.01;
 // A pixel is ill-conditioned when its reference value moves by more than
 // kBadThreshold as the primary rays move by this many pixels.
 constexpr double kConditionShift = 1e-4;
@@ -87,6 +90,15 @@ int worstDifference(const snell::Image& a, const snell::Image& b, int x, int y) 
     return worst;
 }
 
+// How far (in 8-bit steps) the GPU's pixel lies below the reference's value,
+// a lower bound of the exact colour, in its worst channel.
+int belowLowerBound(const snell::Image& gpu, const snell::Image& reference, int x, int y) {
+    int worst = 0;
+    for (int k = 0; k < 3; ++k)
+        worst = std::max(worst, int(snell::toByte(reference.pixel(x, y)[k])) - int(snell::toByte(gpu.pixel(x, y)[k])));
+    return worst;
+}
+
 bool movesFrom(const glm::dvec3& v, const snell::Image& exact, int x, int y) {
     for (int k = 0; k < 3; ++k)
         if (std::abs(int(snell::toByte(float(v[k]))) - int(snell::toByte(exact.pixel(x, y)[k]))) > kBadThreshold)
@@ -135,34 +147,56 @@ TEST_P(GpuAgreement, MatchesCpuReference) {
 
     snell::RenderRequest reference = request;
     reference.trace = snell::kReferenceSettings;
-    reference.boundImage = &referenceBound;
-    const auto cpuStart = std::chrono::steady_clock::now();
     const snell::CpuRenderer cpu(scene);
-    const snell::Image exact = cpu.render(reference);
-    const double cpuMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - cpuStart).count();
+    // The limit reference, rendered once a scene (its fp32 and fp64 cases share it).
+    struct Limit {
+        snell::Image image;
+        std::vector<float> bound;
+        double ms = 0.0;
+    };
+    static std::map<std::string, Limit> limits;
+    if (!limits.count(c.path)) {
+        Limit& l = limits[c.path];
+        snell::RenderRequest r = reference;
+        r.boundImage = &l.bound;
+        const auto cpuStart = std::chrono::steady_clock::now();
+        l.image = cpu.render(r);
+        l.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - cpuStart).count();
+    }
+    const snell::Image& exact = limits[c.path].image;
+    referenceBound = limits[c.path].bound;
+    const double cpuMs = limits[c.path].ms;
 
     const snell::ImageMetrics m = snell::compareImages(gpu.image, exact, kBadThreshold);
-    // Pixels whose exact value the reference cannot certify (light of an
-    // amplifying material that need not decay, or a tree over its budget) are
-    // left out, as are pixels the reference shows to be ill-conditioned; both
-    // are counted. Elsewhere a pixel off by more than the bad-pixel threshold
-    // must, in fp64, lie within the GPU's and the reference's stated bounds
-    // (plus one 8-bit rounding step).
+    // Every term of the ray sum is >= 0, so the reference's value is a lower
+    // bound of the exact colour in every pixel, and its value plus its stated
+    // bound an upper bound (render/Truncation.h): a GPU pixel outside them by
+    // more than the bad-pixel threshold is wrong, certified or not. Pixels the
+    // reference cannot certify (light of an amplifying material that need not
+    // decay, a tree over its budget) and that lie within them are left out, as
+    // are pixels the reference shows to be ill-conditioned (at most
+    // kMaxIllConditioned of them); both are counted. A pixel off by more than
+    // the threshold must, in fp64, lie within the GPU's and the reference's
+    // stated bounds (plus one 8-bit rounding step).
     std::vector<char> excluded(std::size_t(c.size) * c.size, 0);
-    std::uint64_t illConditioned = 0, uncertified = 0, bad = 0, boundViolations = 0;
-    double certifiedError = 0.0;
+    std::uint64_t illConditioned = 0, uncertified = 0, bad = 0, provenWrong = 0, boundViolations = 0;
+    double comparedError = 0.0;
     for (int y = 0; y < c.size; ++y) {
         for (int x = 0; x < c.size; ++x) {
             const std::size_t i = std::size_t(y) * c.size + x;
+            const int worst = worstDifference(gpu.image, exact, x, y);
             if (referenceBound[i] > kCertified) {
-                ++uncertified;
-                excluded[i] = 1;
-                continue;
+                const int below = belowLowerBound(gpu.image, exact, x, y);
+                const int above = worst - int(std::ceil(255.0 * referenceBound[i]));
+                if (std::max(below, above) <= kBadThreshold) {
+                    ++uncertified;
+                    excluded[i] = 1;
+                    continue;
+                }
             }
             for (int k = 0; k < 3; ++k)
-                certifiedError += std::abs(int(snell::toByte(gpu.image.pixel(x, y)[k])) -
-                                           int(snell::toByte(exact.pixel(x, y)[k])));
-            const int worst = worstDifference(gpu.image, exact, x, y);
+                comparedError += std::abs(int(snell::toByte(gpu.image.pixel(x, y)[k])) -
+                                          int(snell::toByte(exact.pixel(x, y)[k])));
             if (worst <= kBadThreshold) continue;
             if (illConditionedAt(cpu, reference, exact, x, y)) {
                 ++illConditioned;
@@ -170,6 +204,7 @@ TEST_P(GpuAgreement, MatchesCpuReference) {
                 continue;
             }
             ++bad;
+            if (referenceBound[i] > kCertified) ++provenWrong;
             // The stated bound covers where the tree stopped, not float32
             // rounding: it is held exactly by the fp64 shader (and by the CPU
             // in tests/test_truncation.cpp).
@@ -180,13 +215,18 @@ TEST_P(GpuAgreement, MatchesCpuReference) {
                               << "/255 (reference)";
         }
     }
-    const std::uint64_t certified = m.pixels - uncertified;
-    const double meanError = certified ? certifiedError / (3.0 * double(certified)) : 0.0;
-    // Speckles: off by more than 8/255 with all eight neighbours within 2/255.
+    const std::uint64_t compared = m.pixels - uncertified - illConditioned;
+    const double meanError = compared ? comparedError / (3.0 * double(compared + illConditioned)) : 0.0;
+    // Speckles (acne, self-intersection): off by more than 8/255 with all
+    // eight neighbours within 2/255, where the reference certifies the pixel.
+    // (An uncertified pixel outside the reference's bounds is bad above; there
+    // an isolated pixel is a diverging orbit of light in an amplifying
+    // material, which float32 geometry may miss where double finds it.)
     std::uint64_t speckles = 0;
     for (int y = 1; y + 1 < c.size; ++y) {
         for (int x = 1; x + 1 < c.size; ++x) {
-            if (excluded[std::size_t(y) * c.size + x] || worstDifference(gpu.image, exact, x, y) <= 8) continue;
+            const std::size_t i = std::size_t(y) * c.size + x;
+            if (excluded[i] || referenceBound[i] > kCertified || worstDifference(gpu.image, exact, x, y) <= 8) continue;
             bool isolated = true;
             for (int dy = -1; dy <= 1; ++dy)
                 for (int dx = -1; dx <= 1; ++dx)
@@ -194,14 +234,16 @@ TEST_P(GpuAgreement, MatchesCpuReference) {
             speckles += isolated;
         }
     }
-    const double badFraction = double(bad) / double(m.pixels);
+    const double badFraction = compared ? double(bad) / double(compared) : 0.0;
+    const double illFraction = double(illConditioned) / double(m.pixels);
     std::cout << "[ metrics ] " << fs::path(c.path).filename().string() << " " << m.json()
-              << " certified_mean_abs_error=" << meanError << " bad_certified=" << bad
+              << " compared_mean_abs_error=" << meanError << " bad=" << bad << " of " << compared
+              << " (below the reference's lower bound or above its upper bound: " << provenWrong << ")"
               << " ill_conditioned_left_out=" << illConditioned << " uncertified_left_out=" << uncertified
               << " speckles_counted=" << speckles << " gpu_ms=" << gpu.renderMs << " cpu_ms=" << cpuMs << "\n";
 
     const bool pass = m.nonFinite == 0 && (speckles == 0 || !c.noSpeckles) && meanError <= kMaxMeanError &&
-                      badFraction <= kMaxBadFraction && boundViolations == 0;
+                      badFraction <= kMaxBadFraction && boundViolations == 0 && illFraction <= kMaxIllConditioned;
     std::string artifacts;
     if (!pass) {
         fs::create_directories(SNELL_ARTIFACT_DIR);
@@ -216,10 +258,12 @@ TEST_P(GpuAgreement, MatchesCpuReference) {
         EXPECT_EQ(speckles, 0u) << "isolated pixels off by more than 8/255 (left out: " << m.speckles - speckles
                                 << " ill-conditioned or uncertified)" << artifacts;
     }
-    EXPECT_LE(meanError, kMaxMeanError) << "over the " << certified << " pixels the reference certifies" << artifacts;
-    EXPECT_LE(badFraction, kMaxBadFraction) << "bad pixels " << bad << " of " << m.pixels << " (ill-conditioned left out "
-                                            << illConditioned << ", uncertified left out " << uncertified << ")"
-                                            << artifacts;
+    EXPECT_LE(meanError, kMaxMeanError) << "over the " << compared << " pixels compared" << artifacts;
+    EXPECT_LE(badFraction, kMaxBadFraction) << "bad pixels " << bad << " of " << compared << " compared ("
+                                            << provenWrong << " outside the reference's bounds; ill-conditioned "
+                                            << "left out " << illConditioned << ", uncertified left out "
+                                            << uncertified << ")" << artifacts;
+    EXPECT_LE(illFraction, kMaxIllConditioned) << illConditioned << " pixels left out as ill-conditioned" << artifacts;
     EXPECT_EQ(boundViolations, 0u) << artifacts;
 }
 

@@ -70,7 +70,7 @@ std::uint32_t skipOf(const gpu::BvhNode& n) { return std::bit_cast<std::uint32_t
 std::uint32_t codeOf(const gpu::BvhNode& n) { return std::bit_cast<std::uint32_t>(n.upper.w); }
 
 TEST(Layout, FrameParams) {
-    EXPECT_EQ(sizeof(gpu::FrameParams), 160u);
+    EXPECT_EQ(sizeof(gpu::FrameParams), 176u);
     EXPECT_EQ(offsetof(gpu::FrameParams, primaryStart), 0u);
     EXPECT_EQ(offsetof(gpu::FrameParams, cornerDir), 16u);
     EXPECT_EQ(offsetof(gpu::FrameParams, pixelRight), 32u);
@@ -78,15 +78,16 @@ TEST(Layout, FrameParams) {
     EXPECT_EQ(offsetof(gpu::FrameParams, background), 64u);
     EXPECT_EQ(offsetof(gpu::FrameParams, ambient), 80u);
     EXPECT_EQ(offsetof(gpu::FrameParams, radiance), 96u);
-    EXPECT_EQ(offsetof(gpu::FrameParams, imageWidth), 112u);
-    EXPECT_EQ(offsetof(gpu::FrameParams, imageHeight), 116u);
-    EXPECT_EQ(offsetof(gpu::FrameParams, supersample), 120u);
-    EXPECT_EQ(offsetof(gpu::FrameParams, maxDepth), 124u);
-    EXPECT_EQ(offsetof(gpu::FrameParams, sphereCount), 128u);
-    EXPECT_EQ(offsetof(gpu::FrameParams, lightCount), 132u);
-    EXPECT_EQ(offsetof(gpu::FrameParams, bvhNodeCount), 136u);
-    EXPECT_EQ(offsetof(gpu::FrameParams, firstSample), 140u);
-    EXPECT_EQ(offsetof(gpu::FrameParams, sampleCount), 144u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, localRadiance), 112u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, imageWidth), 128u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, imageHeight), 132u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, supersample), 136u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, maxDepth), 140u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, sphereCount), 144u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, lightCount), 148u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, bvhNodeCount), 152u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, firstSample), 156u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, sampleCount), 160u);
 }
 
 TEST(Layout, TileParams) {
@@ -101,13 +102,17 @@ TEST(Layout, TileParams) {
 }
 
 TEST(Layout, SlotStateAndPendingRay) {
-    EXPECT_EQ(sizeof(gpu::SlotState), 96u);
-    EXPECT_EQ(offsetof(gpu::SlotState, dropped), 16u);
-    EXPECT_EQ(offsetof(gpu::SlotState, lower), 32u);
-    EXPECT_EQ(offsetof(gpu::SlotState, upper), 48u);
-    EXPECT_EQ(offsetof(gpu::SlotState, pixel), 64u);
-    EXPECT_EQ(offsetof(gpu::SlotState, finished), 76u);
-    EXPECT_EQ(offsetof(gpu::SlotState, treeRays), 80u);
+    EXPECT_EQ(sizeof(gpu::SlotState), 160u);
+    EXPECT_EQ(offsetof(gpu::SlotState, deferred), 16u);
+    EXPECT_EQ(offsetof(gpu::SlotState, lower), 48u);
+    EXPECT_EQ(offsetof(gpu::SlotState, settled), 80u);
+    EXPECT_EQ(offsetof(gpu::SlotState, cutOff), 96u);
+    EXPECT_EQ(offsetof(gpu::SlotState, pixel), 112u);
+    EXPECT_EQ(offsetof(gpu::SlotState, finished), 124u);
+    EXPECT_EQ(offsetof(gpu::SlotState, treeRays), 128u);
+    EXPECT_EQ(offsetof(gpu::SlotState, frontierHead), 144u);
+    EXPECT_EQ(sizeof(gpu::OutputPixel), 32u);
+    EXPECT_EQ(offsetof(gpu::OutputPixel, truncation), 16u);
     EXPECT_EQ(sizeof(gpu::PendingRay), 64u);
     EXPECT_EQ(offsetof(gpu::PendingRay, weight), 32u);
     EXPECT_EQ(offsetof(gpu::PendingRay, depth), 48u);
@@ -198,7 +203,7 @@ TEST(GpuScene, SmallSceneIsOriginRelativeAndClassified) {
     EXPECT_FLOAT_EQ(g.lights[0].colour.r, 0.7f);
     EXPECT_FLOAT_EQ(g.lights[0].colour.b, 0.9f);
 
-    const gpu::FrameParams f = gpu::makeFrameParams(s, g, camera, 10, 10, 1, 0, 0, 32, 1e-4);
+    const gpu::FrameParams f = gpu::makeFrameParams(s, g, camera, 10, 10, 1, 0, 0, {.maxDepth = 32, .minWeight = 1e-4});
     EXPECT_EQ(f.sphereCount, 2u);
     EXPECT_EQ(f.lightCount, 1u);
     EXPECT_EQ(f.bvhNodeCount, 0u);

@@ -172,10 +172,11 @@ void reportTruncation(const snell::TruncationReport& t, const snell::TraceSettin
         if (count > pixels.size()) s += ", ...";
         return ", e.g. " + s;
     };
-    if (t.unbounded > 0)
-        std::cerr << "snell: warning: " << t.unbounded << " pixel(s) dropped light of a material with ks + kt >= 1, "
-                  << "which need not decay: their bound is only the clamp to 1 (--bound-image shows it)"
-                  << examples(t.unboundedExamples, t.unbounded) << "\n";
+    if (t.unbounded > t.estimated)
+        std::cerr << "snell: warning: " << t.unbounded - t.estimated
+                  << " pixel(s) dropped light of a material with ks + kt >= 1, which need not decay, and their "
+                  << "colour had not settled at the floor cut-off: their bound is only the clamp to 1 "
+                  << "(--bound-image shows it)" << examples(t.unboundedExamples, t.unbounded) << "\n";
     if (t.overBudget > 0)
         std::cerr << "snell: warning: " << t.overBudget << " pixel(s) reached the tree budget of "
                   << settings.treeBudget << " rays a sample and were stopped (their bound says by how much they "
@@ -191,7 +192,8 @@ std::string truncationJson(const snell::TruncationReport& t) {
     j.precision(6);
     j << "{\"max_bound\": " << t.maxBound << ", \"mean_bound\": " << t.meanBound()
       << ", \"unbounded_pixels\": " << t.unbounded << ", \"over_budget_pixels\": " << t.overBudget
-      << ", \"over_tolerance_pixels\": " << t.overTolerance << ", \"deepest_ray\": " << t.deepest << "}";
+      << ", \"over_tolerance_pixels\": " << t.overTolerance << ", \"estimated_pixels\": " << t.estimated
+      << ", \"max_estimated_error\": " << t.maxEstimate << ", \"deepest_ray\": " << t.deepest << "}";
     return j.str();
 }
 
@@ -235,6 +237,10 @@ int runRender(const RenderOptions& o) {
     request.trace = o.cpu ? snell::kReferenceSettings : snell::kDefaultSettings;
     if (o.depth) request.trace.maxDepth = *o.depth;
     if (o.minWeight) request.trace.minWeight = *o.minWeight;
+    // A depth or a cut-off without a tolerance asks for that tree, traced
+    // once (POV-Ray's max_trace_level and adc_bailout); with a tolerance they
+    // are its cap and floor.
+    if ((o.depth || o.minWeight) && !o.tolerance) request.trace.tolerance = 0.0;
     if (o.tolerance) request.trace.tolerance = *o.tolerance;
     if (o.treeBudget) request.trace.treeBudget = *o.treeBudget;
     // No runaway trees: without a tree budget, the settings must bound each
@@ -640,16 +646,17 @@ int main(int argc, char** argv) {
     render->add_flag("--cpu", ro.cpu, "Render with the double-precision CPU reference instead of the GPU");
     render->add_option("-s,--size", ro.size, "Image size in pixels (overrides the scene's view n)")
         ->check(CLI::Range(1, snell::ParseLimits::kMaxImageSize));
-    render->add_option("-d,--depth", ro.depth, "Maximum reflection/refraction depth (default: 10000, a safety cap: the tolerance decides)")
+    render->add_option("-d,--depth", ro.depth, "Maximum reflection/refraction depth; without --tolerance, a fixed tree of this depth traced once (default: 10000, a safety cap: the tolerance decides)")
         ->check(CLI::Range(0, 100000));
-    render->add_option("--min-weight", ro.minWeight, "Stop rays whose weight falls below W; with a tolerance, the lowest cut-off tried (default: GPU 1e-5, CPU 1e-7)")
+    render->add_option("--min-weight", ro.minWeight, "Stop rays whose weight falls below W; without --tolerance, a fixed tree traced once; with it, the lowest cut-off tried (default: GPU 1e-5, CPU 1e-7)")
         ->check(kFinite)->check(CLI::Range(0.0, 1.0));
     render->add_option("--tolerance", ro.tolerance,
-                       "Trace each pixel until what its cut-offs may have lost is at most T; 0: a fixed cut-off "
-                       "(default: GPU 0.5/255 = 0.00196, exact in 8 bits; CPU 0.01/255)")
+                       "Trace each pixel until what its cut-offs may have lost is at most T (where no bound exists: until "
+                       "its estimated error is); 0: a fixed tree (default: GPU 0.5/255 = 0.00196, exact in 8 bits; "
+                       "CPU 0.01/255; 0 when --depth or --min-weight is given alone)")
         ->check(kFinite)->check(CLI::Range(0.0, 1.0));
     render->add_option("--tree-budget", ro.treeBudget,
-                       "Stop a sample's ray tree after N rays and report its pixel; 0: no limit (default: 65536)")
+                       "Stop a pixel's ray trees after N rays a sample and report the pixel; 0: no limit (default: 65536)")
         ->check(CLI::NonNegativeNumber);
     render->add_flag("--allow-runaway", ro.allowRunaway,
                      "Trace even when the settings allow a ray tree of astronomical size (no tree budget, and "

@@ -60,7 +60,7 @@ struct ComputeRenderer::Pipeline {
     VkFence fence = VK_NULL_HANDLE;
     vk::Buffer frame, counters, output, slotStates, rayStack, mediaStack;
     vk::Buffer frameLow, rayStackLow;  // fp64 only
-    std::uint32_t rayStackDepth = 1;  // the RAY_STACK specialisation
+    std::uint32_t rayEntries = 1;     // the RAY_STACK and FRONTIER specialisations: an invocation's entries
     std::uint32_t maxMedia = 1;       // the MAX_MEDIA specialisation
     std::uint32_t bindingCount = SNELL_BINDING_COUNT_FP32;
     // What it was built for: kept between renders and reused while these match.
@@ -158,6 +158,11 @@ namespace {
 // cut-off) the depth limit bounds k, up to kMaxRayStack; past that the
 // shader drops the child that would wait and counts it (SNELL_COUNTER_OVERFLOW).
 constexpr std::uint32_t kMaxRayStack = 256;
+// Frontier entries an invocation keeps (trace.comp, deferRay). On a CPU device
+// there are few invocations (a few workgroups a core) and room for many; a GPU
+// needs its invocations more than long frontiers.
+constexpr std::uint32_t kCpuFrontier = 512;
+constexpr std::uint32_t kGpuFrontier = 32;
 std::uint32_t rayStackEntries(const Scene& scene, const TraceSettings& trace, bool reflection) {
     if (!reflection) return 0;
     double lighter = 0.0, gain = 0.0;
@@ -201,6 +206,13 @@ ComputeRenderer::Specialisation ComputeRenderer::specialise(const RenderRequest&
     values[SNELL_SPEC_RAY_STACK] =
         hasRefraction ? rayStackEntries(scene_, request.trace, hasReflection) + 1 : 1;  // + the suspended ray
     values[SNELL_SPEC_AMPLIFYING] = layout_.amplifying;
+    // Under a tolerance, a frontier for the rays a step leaves under its
+    // cut-off; where it is full, rays are traced down to the floor instead.
+    const bool secondaryRays = hasRefraction || hasReflection;
+    values[SNELL_SPEC_FRONTIER] =
+        request.trace.tolerance > 0.0 && secondaryRays
+            ? (context_.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU ? kCpuFrontier : kGpuFrontier)
+            : 0u;
     values[SNELL_SPEC_LOOP_BUDGET] = loopBudget_;
     return values;
 }
@@ -254,7 +266,7 @@ void ComputeRenderer::createPipeline(const Specialisation& values, Pipeline& p) 
     moduleInfo.pCode = wide ? snell_trace_fp64_comp_spv : snell_trace_comp_spv;
     check(vkCreateShaderModule(device, &moduleInfo, nullptr, &p.module), "vkCreateShaderModule");
 
-    p.rayStackDepth = values[SNELL_SPEC_RAY_STACK];
+    p.rayEntries = values[SNELL_SPEC_RAY_STACK] + values[SNELL_SPEC_FRONTIER];
     p.maxMedia = values[SNELL_SPEC_MAX_MEDIA];
     createComputePipeline(p);
 
@@ -355,9 +367,10 @@ GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool count
         // Persistent invocations (trace.comp): on a CPU device a few workgroups
         // per core keep every core busy to the end of the dispatch; on a GPU
         // one per pixel, as many as the memory for their ray stacks allows.
+        const VkDeviceSize rayEntries = VkDeviceSize(values[SNELL_SPEC_RAY_STACK]) + values[SNELL_SPEC_FRONTIER];
         const VkDeviceSize bytesPerSlot =
-            sizeof(gpu::SlotState) + VkDeviceSize(values[SNELL_SPEC_RAY_STACK]) *
-                                         ((wide ? 2 : 1) * sizeof(gpu::PendingRay) + values[SNELL_SPEC_MAX_MEDIA] * 4);
+            sizeof(gpu::SlotState) +
+            rayEntries * ((wide ? 2 : 1) * sizeof(gpu::PendingRay) + values[SNELL_SPEC_MAX_MEDIA] * 4);
         const VkDeviceSize limit = context_.properties().limits.maxStorageBufferRange;
         const VkDeviceSize tilePixels = VkDeviceSize(tileW) * tileH;
         VkDeviceSize slots = std::min(kStackBudget, limit) / bytesPerSlot;
@@ -380,10 +393,9 @@ GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool count
         Pipeline& p = *cached_;
 
         gpu::FrameParams frameLow{};
-        const gpu::FrameParams frame = gpu::makeFrameParams(
-            scene_, layout_, request.camera, request.width, request.height, s, request.firstSample,
-            request.sampleCount, request.trace.maxDepth, request.trace.minWeight, request.trace.tolerance,
-            request.trace.treeBudget, &frameLow);
+        const gpu::FrameParams frame =
+            gpu::makeFrameParams(scene_, layout_, request.camera, request.width, request.height, s,
+                                 request.firstSample, request.sampleCount, request.trace, &frameLow);
         context_.destroy(p.frame);
         context_.destroy(p.frameLow);
         p.frame = context_.createBufferWithData(&frame, sizeof frame, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
@@ -394,17 +406,17 @@ GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool count
             p.slots = slots;
             // Host-visible: the host reads the invocations' progress while they run.
             p.slotStates = context_.createBuffer(slots * sizeof(gpu::SlotState), kStorage, true);
-            p.rayStack = context_.createBuffer(slots * p.rayStackDepth * sizeof(gpu::PendingRay), kStorage, false);
-            p.mediaStack = context_.createBuffer(slots * p.rayStackDepth * p.maxMedia * 4, kStorage, false);
+            p.rayStack = context_.createBuffer(slots * p.rayEntries * sizeof(gpu::PendingRay), kStorage, false);
+            p.mediaStack = context_.createBuffer(slots * p.rayEntries * p.maxMedia * 4, kStorage, false);
             if (wide)
-                p.rayStackLow = context_.createBuffer(slots * p.rayStackDepth * sizeof(gpu::PendingRay), kStorage, false);
+                p.rayStackLow = context_.createBuffer(slots * p.rayEntries * sizeof(gpu::PendingRay), kStorage, false);
         }
         if (tilePixels > p.tilePixels) {
             context_.destroy(p.output);
             p.tilePixels = tilePixels;
             // The tile's pixels, which the host reads where the shader wrote them
             // (on lavapipe, an imageStore in a loop costs 13x a buffer store).
-            p.output = context_.createBuffer(tilePixels * 4 * sizeof(float), kStorage, true);
+            p.output = context_.createBuffer(tilePixels * sizeof(gpu::OutputPixel), kStorage, true);
         }
 
         std::array<VkDescriptorBufferInfo, SNELL_BINDING_COUNT> bufferInfo{};
@@ -562,7 +574,6 @@ GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool count
                                               "lights or a smaller --depth");
                     truncation.deepest = std::max(truncation.deepest, int(counters[SNELL_COUNTER_DEEPEST]));
                     result.stackOverflows += counters[SNELL_COUNTER_OVERFLOW];
-                    truncation.overBudget += counters[SNELL_COUNTER_OVER_BUDGET];
                     if (countRays) {
                         result.rays.primary += counters[SNELL_COUNTER_PRIMARY];
                         result.rays.shadow += counters[SNELL_COUNTER_SHADOW];
@@ -579,20 +590,23 @@ GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool count
                 }
                 // The finished tile, from where the shader wrote it.
                 const auto readStart = Clock::now();
-                const auto* texels = static_cast<const float*>(p.output.mapped);
+                const auto* pixels = static_cast<const gpu::OutputPixel*>(p.output.mapped);
                 for (std::uint32_t y = 0; y < tile.height; ++y) {
                     const int column = int(tile.originX) - area.x0, windowRow = int(tile.originY + y) - area.y0;
                     float* row = request.rowSink ? band.pixel(column, y) : result.image.pixel(column, windowRow);
-                    const float* src = texels + std::size_t(y) * tile.width * 4;
+                    const gpu::OutputPixel* src = pixels + std::size_t(y) * tile.width;
                     const int imageY = int(tile.originY + y);
                     for (std::uint32_t x = 0; x < tile.width; ++x) {
-                        row[x * 3 + 0] = src[x * 4 + 0];
-                        row[x * 3 + 1] = src[x * 4 + 1];
-                        row[x * 3 + 2] = src[x * 4 + 2];
+                        const gpu::OutputPixel& out = src[x];
+                        row[x * 3 + 0] = out.colour.r;
+                        row[x * 3 + 1] = out.colour.g;
+                        row[x * 3 + 2] = out.colour.b;
                         // The pixel's truncation bound, negative where not finite.
-                        const float bound = std::abs(src[x * 4 + 3]);
+                        const float bound = std::abs(out.colour.a);
                         const int imageX = int(tile.originX + x);
-                        truncation.addPixel(imageX, imageY, bound, src[x * 4 + 3] < 0.0f, false);
+                        truncation.addPixel(imageX, imageY, bound, out.colour.a < 0.0f, out.truncation.y != 0.0f);
+                        if (out.truncation.x >= 0.0f) truncation.addEstimate(out.truncation.x);
+                        if (out.truncation.z != 0.0f) ++truncation.overTolerance;
                         if (request.boundImage)
                             (*request.boundImage)[std::size_t(windowRow) * areaWidth + column + x] = bound;
                     }

@@ -174,8 +174,7 @@ GpuScene buildGpuScene(const snell::Scene& scene, const snell::Camera& camera, P
 
 FrameParams makeFrameParams(const snell::Scene& scene, const GpuScene& gpuScene, const snell::Camera& camera,
                             int width, int height, int supersample, int firstSample, int sampleCount,
-                            int maxDepth, double minWeight, double tolerance, std::uint64_t treeBudget,
-                            FrameParams* lowParts) {
+                            const snell::TraceSettings& trace, FrameParams* lowParts) {
     FrameParams f{}, low{};
     // A camera other than the one the layout was built for (the preview's)
     // needs its own start distance.
@@ -186,9 +185,11 @@ FrameParams makeFrameParams(const snell::Scene& scene, const GpuScene& gpuScene,
     splitVec4(camera.pixelDown, 0.0, f.pixelDown, low.pixelDown);
     if (lowParts) *lowParts = low;
     f.background = toVec4(scene.background, snell::kAirEta);
-    f.ambient = toVec4(scene.ambient, minWeight);
+    f.ambient = toVec4(scene.ambient, trace.minWeight);
     // +inf stays +inf in float: the shader tests for it.
-    f.radiance = toVec4(snell::radianceBound(scene).radiance, tolerance);
+    const snell::RadianceBound radiance = snell::radianceBound(scene);
+    f.radiance = toVec4(radiance.radiance, trace.tolerance);
+    f.localRadiance = toVec4(radiance.local, snell::kAmplifiedEstimate);
     f.imageWidth = static_cast<uint>(width);
     f.imageHeight = static_cast<uint>(height);
     f.supersample = static_cast<uint>(supersample);
@@ -196,8 +197,9 @@ FrameParams makeFrameParams(const snell::Scene& scene, const GpuScene& gpuScene,
     f.firstSample = static_cast<uint>(std::clamp(firstSample, 0, grid - 1));
     f.sampleCount = static_cast<uint>(sampleCount > 0 ? std::min(sampleCount, grid - int(f.firstSample))
                                                       : grid - int(f.firstSample));
-    f.maxDepth = static_cast<uint>(maxDepth);
-    f.treeBudget = static_cast<uint>(std::min<std::uint64_t>(treeBudget, 0xffffffffu));
+    f.maxDepth = static_cast<uint>(trace.maxDepth);
+    f.treeBudget = static_cast<uint>(std::min<std::uint64_t>(trace.treeBudget, 0xffffffffu));
+    f.estimate = trace.estimate ? 1u : 0u;
     f.sphereCount = static_cast<uint>(gpuScene.spheres.size());
     f.lightCount = static_cast<uint>(gpuScene.lights.size());
     f.bvhNodeCount = static_cast<uint>(gpuScene.nodes.size());

@@ -9,6 +9,7 @@
 #include <cstddef>
 #include <vector>
 
+#include "render/RenderRequest.h"
 #include "scene/Parser.h"
 #include "scene/Scene.h"
 #include "shared_layout.h"
@@ -21,13 +22,15 @@ static_assert(sizeof(Material) == 48 && offsetof(Material, kt) == 32);
 static_assert(sizeof(Light) == 32 && offsetof(Light, colour) == 16);
 static_assert(sizeof(BvhNode) == 32 && offsetof(BvhNode, upper) == 16);
 static_assert(sizeof(SphereBlock) == 32 * SNELL_BLOCK_SPHERES);
-static_assert(sizeof(FrameParams) == 160 && offsetof(FrameParams, cornerDir) == 16 &&
-              offsetof(FrameParams, radiance) == 96 && offsetof(FrameParams, imageWidth) == 112 &&
-              offsetof(FrameParams, bvhNodeCount) == 136 && offsetof(FrameParams, sampleCount) == 144);
+static_assert(sizeof(FrameParams) == 176 && offsetof(FrameParams, cornerDir) == 16 &&
+              offsetof(FrameParams, radiance) == 96 && offsetof(FrameParams, imageWidth) == 128 &&
+              offsetof(FrameParams, bvhNodeCount) == 152 && offsetof(FrameParams, sampleCount) == 160);
 static_assert(sizeof(TileParams) == 32 && offsetof(TileParams, resume) == 16 && offsetof(TileParams, stepY) == 24);
-static_assert(sizeof(SlotState) == 96 && offsetof(SlotState, dropped) == 16 && offsetof(SlotState, upper) == 48 &&
-              offsetof(SlotState, pixel) == 64 && offsetof(SlotState, finished) == 76 &&
-              offsetof(SlotState, treeRays) == 80 && offsetof(SlotState, rays) == 88);
+static_assert(sizeof(SlotState) == 160 && offsetof(SlotState, lost) == 32 && offsetof(SlotState, cutOff) == 96 &&
+              offsetof(SlotState, pixel) == 112 && offsetof(SlotState, finished) == 124 &&
+              offsetof(SlotState, treeRays) == 128 && offsetof(SlotState, rays) == 136 &&
+              offsetof(SlotState, frontierOld) == 152);
+static_assert(sizeof(OutputPixel) == 32 && offsetof(OutputPixel, truncation) == 16);
 static_assert(sizeof(PendingRay) == 64 && offsetof(PendingRay, depth) == 48 && offsetof(PendingRay, resumeShading) == 60);
 // An ellipsoid's index rides in a float (Sphere::anchorRadius.w), exact to the
 // documented sphere limit.
@@ -79,8 +82,7 @@ double primaryStartDistance(const snell::Scene& scene, const snell::dvec3& eye);
 // `lowParts`, also the low parts of its float pairs (for the fp64 shader).
 FrameParams makeFrameParams(const snell::Scene& scene, const GpuScene& gpuScene, const snell::Camera& camera,
                             int width, int height, int supersample, int firstSample, int sampleCount,
-                            int maxDepth, double minWeight, double tolerance = 0.0, std::uint64_t treeBudget = 0,
-                            FrameParams* lowParts = nullptr);
+                            const snell::TraceSettings& trace, FrameParams* lowParts = nullptr);
 
 // A double as the float pair hi + lo: hi = float(v), lo = float(v − hi).
 void splitDouble(double v, float& hi, float& lo);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <array>
+#include <limits>
 #include <optional>
 #include <thread>
 #include <vector>
@@ -90,13 +91,20 @@ struct CpuRenderer::PendingRay {
     MediumStack media;
 };
 
-// What one sample's tree did not trace: the weight it dropped (depth limit,
-// cut-off, budget), how many rays it traced and how deep it went.
-struct CpuRenderer::SampleTrace {
-    dvec3 dropped{0.0};
+// What a pixel's trees did not trace so far (render/Truncation.h): the weight
+// lost for good (depth limit, tree budget) and the rays left under the cut-off
+// (`frontier`, which a lower cut-off continues from); how many rays they traced
+// and how deep they went.
+struct CpuRenderer::TreeTrace {
+    dvec3 lost{0.0};
+    dvec3 deferred{0.0};          // the weight of the rays in `frontier`
+    double heaviestDeferred = 0.0;
+    std::vector<PendingRay> frontier;
     std::uint64_t rays = 0;
+    std::uint64_t budget = 0;     // the most rays they may trace; 0: no limit
     int deepest = 0;
     bool overBudget = false;
+    bool amplified = false;       // a hit gained weight (ks + kt > 1 where the ray carried light)
 };
 
 CpuRenderer::CpuRenderer(const Scene& scene) : scene_(scene) {
@@ -179,32 +187,52 @@ bool CpuRenderer::occluded(const Ray& ray, double distance, std::uint32_t fromSp
     return false;
 }
 
-// One sample's ray tree (SPEC §4), depth first with an explicit stack, adding
-// each ray's local term straight into pixelSum. A channel whose pixel sum has
-// reached `saturation` is final in 8 bits (SPEC §4 "amplifying materials"), so
-// its weight is dropped from then on. Every ray not traced adds its weight to
-// sample.dropped (render/Truncation.h).
-void CpuRenderer::trace(const PendingRay& primary, dvec3& pixelSum, double saturation, double cutOff,
-                        const TraceSettings& settings, RayCounts& counts, SampleTrace& sample) const {
+// The ray tree (SPEC §4) below `root` (a camera ray, or a ray an earlier
+// cut-off left), depth first with an explicit stack, adding each ray's local
+// term straight into pixelSum. A channel whose pixel sum has reached
+// `saturation` is final in 8 bits (SPEC §4 "amplifying materials"), so its
+// weight is dropped from then on. A ray under the cut-off waits in
+// tree.frontier for a lower one; one that the depth limit or the budget stops
+// is lost (render/Truncation.h).
+void CpuRenderer::trace(const PendingRay& root, dvec3& pixelSum, double saturation, double cutOff,
+                        const TraceSettings& settings, RayCounts& counts, TreeTrace& tree) const {
     std::vector<PendingRay> stack;
-    stack.push_back(primary);
-    ++counts.primary;
+    stack.push_back(root);
+    const bool continues = settings.tolerance > 0.0;
     auto worthTracing = [&](const dvec3& w) {
         const double m = maxComponent(w);
         return m > 0.0 && m >= cutOff;
+    };
+    // A ray under the cut-off: the next, lower cut-off starts from it (under
+    // the floor no cut-off will, and it is lost).
+    auto defer = [&](PendingRay&& r) {
+        const double m = maxComponent(r.weight);
+        if (!(m > 0.0)) return;
+        if (!continues || (m < settings.minWeight && !amplifying_)) {
+            tree.lost += r.weight;
+            return;
+        }
+        tree.deferred += r.weight;
+        tree.heaviestDeferred = std::max(tree.heaviestDeferred, m);
+        tree.frontier.push_back(std::move(r));
     };
     while (!stack.empty()) {
         PendingRay r = std::move(stack.back());
         stack.pop_back();
         for (int k = 0; k < 3; ++k)
             if (pixelSum[k] >= saturation) r.weight[k] = 0.0;
-        if (!worthTracing(r.weight) || (settings.treeBudget != 0 && sample.rays >= settings.treeBudget)) {
-            if (worthTracing(r.weight)) sample.overBudget = true;
-            sample.dropped += r.weight;
+        if (!worthTracing(r.weight)) {
+            defer(std::move(r));
             continue;
         }
-        ++sample.rays;
-        sample.deepest = std::max(sample.deepest, r.depth);
+        if (tree.budget != 0 && tree.rays >= tree.budget) {
+            tree.overBudget = true;
+            tree.lost += r.weight;
+            continue;
+        }
+        ++tree.rays;
+        tree.deepest = std::max(tree.deepest, r.depth);
+        if (r.depth > 0) ++(r.refracted ? counts.refracted : counts.reflected);
 
         // 1. Closest hit.
         Hit hit;
@@ -256,13 +284,23 @@ void CpuRenderer::trace(const PendingRay& primary, dvec3& pixelSum, double satur
         const dvec3 reflectedGain = settings.reflection ? m.ks : dvec3(0.0);
         const dvec3 transmittedGain = settings.refraction && m.refracts() ? m.kt : dvec3(0.0);
         if (r.depth >= settings.maxDepth) {
-            sample.dropped += weighted(r.weight, reflectedGain + transmittedGain);
+            tree.lost += weighted(r.weight, reflectedGain + transmittedGain);
             continue;
         }
+
+        // Light carried into a material of ks + kt > 1 (SPEC §4 amplifying
+        // materials) can grow: an orbit of total internal reflection repeats
+        // its angle for ever, and a path of tiny weight that enters one grows
+        // until its channel saturates. The pixel's series may diverge behind
+        // steps that seem to settle, so its estimated error must be within
+        // kAmplifiedEstimate.
+        for (int c = 0; c < 3; ++c)
+            if (reflectedGain[c] + transmittedGain[c] > 1.0 && r.weight[c] > 0.0) tree.amplified = true;
         dvec3 reflectedWeight = childWeight(r.weight, reflectedGain);
+        dvec3 transmittedWeight(0.0);
         std::optional<PendingRay> refractedRay;
         if (settings.refraction && m.refracts()) {
-            const dvec3 transmittedWeight = childWeight(r.weight, transmittedGain);
+            transmittedWeight = childWeight(r.weight, transmittedGain);
             MediumStack media = r.media;
             double etaI, etaT;
             if (fromOutside) {
@@ -279,22 +317,15 @@ void CpuRenderer::trace(const PendingRay& primary, dvec3& pixelSum, double satur
                 // Total internal reflection is the reflected ray in the same
                 // medium: one ray carrying both weights (exactly SPEC §4.5).
                 reflectedWeight = glm::min(reflectedWeight + transmittedWeight, dvec3(kMaxWeight));
-            } else if (worthTracing(transmittedWeight)) {
+            } else {
                 refractedRay = PendingRay{{x, refracted}, transmittedWeight, r.depth + 1, hit.sphere,
                                           fromOutside, true, media};
-            } else {
-                sample.dropped += transmittedWeight;
+                if (!worthTracing(transmittedWeight)) defer(*std::move(refractedRay)), refractedRay.reset();
             }
         }
-        std::optional<PendingRay> reflectedRay;
-        if (worthTracing(reflectedWeight)) {
-            reflectedRay = PendingRay{{x, reflectDirection(d, n)}, reflectedWeight, r.depth + 1, hit.sphere,
-                                      !fromOutside, false, r.media};
-        } else {
-            sample.dropped += reflectedWeight;
-        }
-        if (reflectedRay) ++counts.reflected;
-        if (refractedRay) ++counts.refracted;
+        std::optional<PendingRay> reflectedRay =
+            PendingRay{{x, reflectDirection(d, n)}, reflectedWeight, r.depth + 1, hit.sphere, !fromOutside, false, r.media};
+        if (!worthTracing(reflectedWeight)) defer(*std::move(reflectedRay)), reflectedRay.reset();
         // The lighter child is traced next and the heavier waits (as the
         // shader does, whose stack this bounds: ComputeRenderer.cpp); in an
         // amplifying scene the heavier goes first, so that a tree budget is
@@ -307,16 +338,6 @@ void CpuRenderer::trace(const PendingRay& primary, dvec3& pixelSum, double satur
     }
 }
 
-// The cut-off a tolerance starts from: the tolerance over the largest finite
-// radiance bound (a few dropped rays then stay within it), at least the floor.
-static double firstCutOff(const TraceSettings& settings, const RadianceBound& radiance) {
-    if (settings.tolerance <= 0.0) return settings.minWeight;
-    double largest = 1.0;
-    for (int c = 0; c < 3; ++c)
-        if (std::isfinite(radiance.radiance[c])) largest = std::max(largest, radiance.radiance[c]);
-    return std::max(settings.minWeight, settings.tolerance / (4.0 * largest));
-}
-
 CpuRenderer::Pixel CpuRenderer::renderPixel(const RenderRequest& request, int x, int y, RayCounts& counts) const {
     const int s = std::max(1, request.supersample);
     const int first = std::clamp(request.firstSample, 0, s * s - 1);
@@ -327,32 +348,66 @@ CpuRenderer::Pixel CpuRenderer::renderPixel(const RenderRequest& request, int x,
     const double saturation = amplifying_ ? samples : kNoHit;
     const TraceSettings& settings = request.trace;
     Pixel pixel;
-    // With a tolerance, the pixel is traced again with a 16x lower cut-off
-    // until its bound is within it (or the cut-off reaches its floor), keeping
-    // what each attempt proved (PixelEstimate).
+    // The pixel's trees at the first cut-off; then, while its bound is over
+    // the tolerance, the rays they left under the cut-off are traced on with
+    // the next rung at or below the heaviest of them: together the very tree
+    // one pass at that cut-off traces, with no ray traced twice. What each
+    // step proves is kept (PixelEstimate).
     PixelEstimate estimate;
-    for (double cutOff = firstCutOff(settings, radiance_);; cutOff = std::max(settings.minWeight, cutOff / 16.0)) {
-        dvec3 sum(0.0);
-        SampleTrace tree;
-        for (int k = first; k < first + count; ++k) {
-            // SPEC §3: sub-pixel (a, b) at x = i + (a + ½)/s, y = j + (b + ½)/s.
-            const int a = k % s, b = k / s;
-            const double px = x + (a + 0.5) / s;
-            const double py = y + (b + 0.5) / s;
-            PendingRay primary;
-            primary.ray = {request.camera.eye, request.camera.direction(px, py)};
-            tree.rays = 0;
-            trace(primary, sum, saturation, cutOff, settings, counts, tree);
-        }
-        estimate.add(radiance_, sum, tree.dropped, samples);
+    ErrorEstimate change;
+    dvec3 sum(0.0);
+    TreeTrace tree;
+    tree.budget = settings.treeBudget * std::uint64_t(count);
+    const bool continues = settings.tolerance > 0.0;
+    for (int k = first; k < first + count; ++k) {
+        // SPEC §3: sub-pixel (a, b) at x = i + (a + ½)/s, y = j + (b + ½)/s.
+        const int a = k % s, b = k / s;
+        const double px = x + (a + 0.5) / s;
+        const double py = y + (b + 0.5) / s;
+        PendingRay primary;
+        primary.ray = {request.camera.eye, request.camera.direction(px, py)};
+        ++counts.primary;
+        trace(primary, sum, saturation, continues ? std::max(settings.minWeight, kFirstRung) : settings.minWeight,
+              settings, counts, tree);
+    }
+    for (;;) {
+        estimate.add(radiance_, sum, tree.lost + tree.deferred, samples);
+        change.add(estimate.lower, tree.deferred * radiance_.local / samples);
         pixel.colour = estimate.lower;
         pixel.bound = estimate.bound();
         pixel.unbounded = estimate.unbounded();
-        pixel.overBudget = pixel.overBudget || tree.overBudget;
-        pixel.deepest = std::max(pixel.deepest, tree.deepest);
+        pixel.overBudget = tree.overBudget;
+        pixel.deepest = tree.deepest;
         const bool within = pixel.bound <= settings.tolerance;
-        pixel.overTolerance = settings.tolerance > 0.0 && !within;
-        if (settings.tolerance <= 0.0 || within || cutOff <= settings.minWeight) break;
+        pixel.overTolerance = continues && !within;
+        // Done: certified; or nothing left under the cut-off (a lower one
+        // would trace the same tree); or at the floor; or, where allowed, the
+        // estimated error is within the tolerance.
+        if (!continues || within || tree.frontier.empty()) break;
+        const double error = change.error();
+        if (settings.estimate && pixel.unbounded && error <= settings.tolerance &&
+            (!tree.amplified || error <= kAmplifiedEstimate)) {
+            pixel.estimated = true;
+            pixel.estimatedError = error;
+            pixel.overTolerance = false;
+            break;
+        }
+        // The next rung: the highest that traces a ray the last step left, not
+        // under the floor; but a pixel whose trees gained weight goes on below
+        // it, until its diverging channels saturate or its trees reach the
+        // budget (SPEC §4 amplifying materials).
+        const bool belowFloor = tree.amplified && pixel.unbounded && tree.budget != 0;
+        const double rung = cutOffRung(tree.heaviestDeferred);
+        // (Below the floor it steps 16x at a time: such pixels go on to the
+        // budget or saturation anyway, and fewer steps cost less.)
+        const double cutOff = belowFloor ? rung / 16.0 : std::max(settings.minWeight, rung);
+        // Everything left is under the floor, or the budget is spent.
+        if (cutOff > tree.heaviestDeferred || !(cutOff >= std::numeric_limits<float>::min()) || tree.overBudget) break;
+        std::vector<PendingRay> waiting = std::move(tree.frontier);
+        tree.frontier.clear();
+        tree.deferred = dvec3(0.0);
+        tree.heaviestDeferred = 0.0;
+        for (const PendingRay& r : waiting) trace(r, sum, saturation, cutOff, settings, counts, tree);
     }
     return pixel;
 }
@@ -392,6 +447,7 @@ Image CpuRenderer::render(const RenderRequest& request, RayCounts* counts) const
                     TruncationReport& t = truncation[id];
                     t.addPixel(x, y, pixel.bound, pixel.unbounded, pixel.overBudget);
                     t.overTolerance += pixel.overTolerance;
+                    if (pixel.estimated) t.addEstimate(pixel.estimatedError);
                     t.deepest = std::max(t.deepest, pixel.deepest);
                     if (request.boundImage)
                         (*request.boundImage)[static_cast<std::size_t>(row) * width + column] =

@@ -25,6 +25,8 @@ public:
         bool unbounded = false;     // light was dropped where it need not decay
         bool overBudget = false;    // a sample's tree reached TraceSettings::treeBudget
         bool overTolerance = false; // still above the tolerance at the floor cut-off
+        bool estimated = false;     // unbounded, and stopped by its estimated error (render/Truncation.h)
+        double estimatedError = 0.0;
         int deepest = 0;            // the deepest ray traced
     };
     Pixel renderPixel(const RenderRequest& request, int x, int y, RayCounts& counts) const;
@@ -33,9 +35,9 @@ public:
 private:
     struct Hit;
     struct PendingRay;
-    struct SampleTrace;
-    void trace(const PendingRay& primary, glm::dvec3& pixelSum, double saturation, double cutOff,
-               const TraceSettings& settings, RayCounts& counts, SampleTrace& sample) const;
+    struct TreeTrace;
+    void trace(const PendingRay& root, glm::dvec3& pixelSum, double saturation, double cutOff,
+               const TraceSettings& settings, RayCounts& counts, TreeTrace& tree) const;
     bool closestHit(const Ray& ray, std::uint32_t fromSphere, StartsOn start, Hit& hit) const;
     bool occluded(const Ray& ray, double distance, std::uint32_t fromSphere, StartsOn start) const;
     double intersect(std::uint32_t sphere, const Ray& ray, std::uint32_t fromSphere, StartsOn start) const;

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <atomic>
+#include <cmath>
 #include <cstdint>
 #include <functional>
 #include <vector>
@@ -21,28 +22,56 @@ struct TraceSettings {
     bool reflection = true;
     bool refraction = true;
     // > 0: trace each pixel until its truncation bound (render/Truncation.h) is
-    // at most this, lowering the cut-off 16x at a time from tolerance / R down
-    // to minWeight, which is then the floor rather than the cut-off.
+    // at most this. The cut-off steps down a ladder of powers of two
+    // (kFirstRung), each step continuing from the rays the last one left under
+    // its cut-off, down to minWeight, which is then the floor rather than the
+    // cut-off. 0: one tree with the fixed cut-off minWeight and depth limit
+    // maxDepth.
     double tolerance = 0.0;
-    // The most rays (closest-hit queries) one sample's tree may trace before it
-    // is stopped and its pixel reported over budget; 0: no limit. Amplifying
-    // trees (SPEC §4) can grow without end; this keeps a render finite.
+    // With a tolerance, a pixel that cannot be certified (light dropped where
+    // it need not decay, R = +inf) stops once its estimated error (the change
+    // of its last step, extrapolated as a geometric series) is within the
+    // tolerance; off, it goes on to the floor.
+    bool estimate = false;
+    // The most rays (closest-hit queries) a pixel's trees may trace, per
+    // sample, before the pixel is stopped and reported over budget; 0: no
+    // limit. Amplifying trees (SPEC §4) can grow without end; this keeps a
+    // render finite.
     std::uint64_t treeBudget = 0;
 };
 
 // The exact image (SPEC §4, the limit of the ray tree) as far as it can be
 // certified: depth bounded only by weight (a safety cap far beyond any
-// converged tree), each pixel traced until its truncation bound is below
-// 1/100 of an 8-bit step, and a tree budget that keeps amplifying trees finite.
-inline constexpr TraceSettings kReferenceSettings{10000, 1e-7, true, true, true, 0.01 / 255.0,
-                                                  std::uint64_t(1) << 16};
-// What `snell render` uses unless told otherwise (docs/performance.md,
-// "Defaults"): each pixel certified within half an 8-bit step where the scene
-// allows it, cut-offs no lower than 1e-5, trees of amplifying scenes bounded.
-inline constexpr TraceSettings kDefaultSettings{10000, 1e-5, true, true, true, 0.5 / 255.0,
-                                                std::uint64_t(1) << 16};
+// converged tree), each pixel traced until its truncation bound (or, where it
+// has none, its estimated error) is below 1/100 of an 8-bit step, and a tree
+// budget that keeps amplifying trees finite.
+inline constexpr TraceSettings kReferenceSettings{.maxDepth = 10000,
+                                                  .minWeight = 1e-7,
+                                                  .tolerance = 0.01 / 255.0,
+                                                  .estimate = true,
+                                                  .treeBudget = std::uint64_t(1) << 16};
+// What `snell render` uses unless told otherwise (docs/design.md, "Defaults"):
+// each pixel certified within half an 8-bit step where the scene allows it,
+// else stopped by its estimated error; cut-offs no lower than 1e-5; trees of
+// amplifying scenes bounded.
+inline constexpr TraceSettings kDefaultSettings{.maxDepth = 10000,
+                                                .minWeight = 1e-5,
+                                                .tolerance = 0.5 / 255.0,
+                                                .estimate = true,
+                                                .treeBudget = std::uint64_t(1) << 16};
 // The preview's, for frames in tens of milliseconds: a fixed depth and cut-off.
-inline constexpr TraceSettings kPreviewSettings{64, 1e-4, true, true, true, 0.0, 0};
+inline constexpr TraceSettings kPreviewSettings{.maxDepth = 64, .minWeight = 1e-4};
+
+// The cut-offs a tolerance tries are rungs 2^-k of one ladder, from kFirstRung
+// down, whatever the tolerance: each step traces on from the rays the last one
+// left, so the tree at a rung is the same however it was reached, and a looser
+// tolerance stops on the same rung or a higher one: it never traces more.
+inline constexpr double kFirstRung = 0.25;
+inline double cutOffRung(double weight) {  // the highest rung <= weight (weight > 0)
+    int exponent = 0;
+    std::frexp(weight, &exponent);  // weight = m · 2^exponent, m in [1/2, 1)
+    return std::ldexp(0.5, exponent);
+}
 
 struct RayCounts {
     std::uint64_t primary = 0;

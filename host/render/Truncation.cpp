@@ -51,6 +51,28 @@ bool PixelEstimate::unbounded() const {
     return false;
 }
 
+void ErrorEstimate::add(const glm::dvec3& colour, const glm::dvec3& notTracedLight) {
+    const glm::dvec3 clamped = glm::min(colour, glm::dvec3(1.0));
+    double weight = 0.0;  // in the channels that can still move
+    for (int c = 0; c < 3; ++c)
+        if (clamped[c] < 1.0) weight = std::max(weight, notTracedLight[c]);
+    if (steps > 0) {
+        previousChange = lastChange;
+        lastChange = std::max({std::abs(clamped.x - last.x), std::abs(clamped.y - last.y), std::abs(clamped.z - last.z)});
+    }
+    previousWeight = lastWeight;
+    lastWeight = weight;
+    last = clamped;
+    ++steps;
+}
+
+double ErrorEstimate::error() const {
+    if (steps < 3 || !(lastWeight < previousWeight)) return std::numeric_limits<double>::infinity();
+    const double rho = std::max(lastChange / previousChange, lastWeight / previousWeight);
+    if (!(rho < 1.0) && lastChange > 0.0) return std::numeric_limits<double>::infinity();
+    return std::max(lastWeight, lastChange > 0.0 ? lastChange / (1.0 - rho) : 0.0);
+}
+
 TreeSizeBound treeSizeBound(const Scene& scene, int maxDepth, double minWeight) {
     TreeSizeBound b;
     bool branches = false;  // a hit can have two children
@@ -92,7 +114,14 @@ void TruncationReport::addPixel(int x, int y, double bound, bool isUnbounded, bo
     }
 }
 
+void TruncationReport::addEstimate(double error) {
+    ++estimated;
+    maxEstimate = std::max(maxEstimate, error);
+}
+
 void TruncationReport::merge(const TruncationReport& o) {
+    estimated += o.estimated;
+    maxEstimate = std::max(maxEstimate, o.maxEstimate);
     maxBound = std::max(maxBound, o.maxBound);
     sumBound += o.sumBound;
     pixels += o.pixels;

@@ -49,6 +49,36 @@ struct PixelEstimate {
     bool unbounded() const;
 };
 
+// The error of a pixel that cannot be certified (light dropped where it need
+// not decay), estimated after each step of the cut-off from how far the step
+// moved its colour and how the weight it has not traced yet (in channels not
+// yet saturated) changed: where both shrink, by ratios up to rho < 1 a step,
+// the steps still to come add about change · rho / (1 − rho), a geometric
+// series; the estimate is that plus the last change itself, and at least the
+// untraced weight times the most light a single hit returns (its children
+// aside). Where the weight not traced does not shrink (light trapped in an
+// amplifying material) there is no estimate: the pixel goes on. An estimate,
+// not a bound (docs/accuracy.md measures how it holds).
+struct ErrorEstimate {
+    glm::dvec3 last{0.0};  // the colour after the last step, clamped (SPEC §6)
+    double lastChange = std::numeric_limits<double>::infinity();
+    double previousChange = std::numeric_limits<double>::infinity();
+    double lastWeight = std::numeric_limits<double>::infinity();      // not traced after the last step
+    double previousWeight = std::numeric_limits<double>::infinity();  // and after the one before
+    int steps = 0;
+
+    // The pixel's colour after a step, and the weight it has not traced (per
+    // sample) times the most light one hit returns (RadianceBound::local).
+    void add(const glm::dvec3& colour, const glm::dvec3& notTracedLight);
+    double error() const;  // +inf while unknown (fewer than three steps) or not shrinking
+};
+
+// A pixel whose trees gained weight (SPEC §4 amplifying materials) may hide a
+// diverging series behind steps that seem to settle: it stops on its estimated
+// error only within this as well as the tolerance (1/100 of an 8-bit step, the
+// limit reference's tolerance).
+inline constexpr double kAmplifiedEstimate = 0.01 / 255.0;
+
 // The most rays one sample's tree can hold under a depth limit D, a weight
 // cut-off w and no tree budget, from the materials alone: level d of the tree
 // holds at most 2^d rays (1 where no material both reflects and refracts), and (as children carry at most g = max(ks + kt) of
@@ -70,6 +100,8 @@ struct TruncationReport {
     std::uint64_t unbounded = 0;     // pixels whose lost light has no finite bound
     std::uint64_t overBudget = 0;    // pixels stopped by the tree budget, not finished
     std::uint64_t overTolerance = 0; // pixels still above the tolerance when the cut-off reached its floor
+    std::uint64_t estimated = 0;     // unbounded pixels stopped by their estimated error (ErrorEstimate)
+    double maxEstimate = 0.0;        // the largest estimated error of those
     int deepest = 0;                 // the deepest ray traced (generations below the primary ray)
     static constexpr std::size_t kExamples = 8;
     std::vector<std::array<int, 2>> unboundedExamples;   // the first few, (x, y)
@@ -77,6 +109,7 @@ struct TruncationReport {
 
     double meanBound() const { return pixels ? sumBound / double(pixels) : 0.0; }
     void addPixel(int x, int y, double bound, bool isUnbounded, bool isOverBudget);
+    void addEstimate(double error);  // the pixel just added was stopped by its estimated error
     void merge(const TruncationReport& other);
 };
 

@@ -1,0 +1,73 @@
+#!/usr/bin/env bash
+# What the trace settings ask for, read from --stats ray counts and images
+# (never from timings):
+# * a depth or a cut-off without --tolerance is one fixed tree, traced once,
+#   the same as with --tolerance 0;
+# * under a tolerance no ray is traced twice: each camera ray once, however
+#   many cut-off steps a pixel takes;
+# * a looser tolerance never traces more rays;
+# * a diverging pixel (light trapped in an amplifying material) comes out
+#   saturated, as the limit reference has it.
+set -u
+: "${SNELL:?}" "${SOURCE:?}" "${SHARED:?}"
+work=$(mktemp -d)
+trap 'rm -rf "$work"' EXIT
+pass=0 fail=0
+ok() { pass=$((pass + 1)); }
+bad() { echo "FAIL: $*"; fail=$((fail + 1)); }
+
+# rays SCENE SIZE OUT ARGS...: prints "total primary" from --stats.
+rays() {
+  local scene=$1 size=$2 out=$3
+  shift 3
+  "$SNELL" render "$scene" --size "$size" -q --stats -o "$out" "$@" | tail -n 1 |
+    python3 -c 'import json, sys; d = json.loads(sys.stdin.read())["rays"]; print(d["total"], d["primary"])'
+}
+same_image() { cmp -s "$1" "$2"; }
+
+scenes=("$SHARED/bench-scenes/glass.scn" "$SHARED/bench-scenes/simple.scn" "$SHARED/bench-scenes/grid.scn"
+        "$SOURCE/scenes/showcase.scn" "$SOURCE/scenes/glass.scn" "$SOURCE/scenes/hard/light-between-mirrors.scn"
+        "$SHARED/course-scenes/becker-1n.scn" "$SHARED/course-scenes/becker-SphereFlake2.scn")
+size=24
+
+for scene in "${scenes[@]}"; do
+  name=$(basename "$scene" .scn)
+  spp=$(awk '$1 == "supersample" {print $2}' "$scene" | tail -n 1)
+  pixels=$((size * size * ${spp:-1} * ${spp:-1}))
+
+  # A fixed tree: --depth / --min-weight alone trace it once, as --tolerance 0 does.
+  for fixed in "--depth 5 --min-weight 0" "--min-weight 0.001" "--depth 3"; do
+    # shellcheck disable=SC2086
+    alone=$(rays "$scene" $size "$work/a.pfm" $fixed)
+    # shellcheck disable=SC2086
+    zero=$(rays "$scene" $size "$work/z.pfm" $fixed --tolerance 0)
+    [ "$alone" = "$zero" ] && same_image "$work/a.pfm" "$work/z.pfm" && ok ||
+      bad "$name: '$fixed' traced '$alone' rays, with --tolerance 0 '$zero' (or another image)"
+    [ "${alone#* }" = "$pixels" ] && ok || bad "$name: '$fixed' traced ${alone#* } camera rays for $pixels samples"
+  done
+
+  # Under tolerances, looser to tighter: each camera ray once, and never more
+  # rays for a looser tolerance.
+  previous=0
+  for tolerance in 0.0314 0.0078 0.00196 0.0004; do
+    counts=$(rays "$scene" $size "$work/t.pfm" --tolerance "$tolerance")
+    total=${counts% *}
+    [ "${counts#* }" = "$pixels" ] && ok || bad "$name: --tolerance $tolerance traced ${counts#* } camera rays for $pixels samples"
+    [ "$total" -ge "$previous" ] && ok || bad "$name: --tolerance $tolerance traced $total rays, a looser one $previous"
+    previous=$total
+  done
+done
+
+# Light trapped in a sphere of ks + kt > 1 diverges, and the pixel saturates:
+# the default render agrees with the limit reference there (8-bit values).
+scene="$SOURCE/scenes/hard/glass-in-water-gap-0.scn"
+"$SNELL" render "$scene" --size 48 -q -o "$work/gpu.png" && "$SNELL" render "$scene" --size 48 --cpu -q -o "$work/ref.png" &&
+  "$SNELL" compare "$work/gpu.png" "$work/ref.png" --json >"$work/cmp" && ok || bad "diverging scene did not render"
+python3 - "$work/cmp" <<'EOF' && ok || bad "diverging pixels differ from the limit reference: $(cat "$work/cmp")"
+import json, sys
+m = json.load(open(sys.argv[1]))
+sys.exit(0 if m["bad_pixels"] <= 2 else 1)
+EOF
+
+echo "tree tests: $pass passed, $fail failed"
+[ "$fail" -eq 0 ]
