@@ -710,6 +710,53 @@ void main() {
             state.pending = 0u;
             state.pixel = tilePixels;
         }
+        // A step of the pixel is finished when it has no ray left: what it
+        // proves, and whether a lower cut-off is worth it (then the step goes
+        // on from the frontier in this very pass).
+        if (!done && !hasRay && state.pending == 0u && state.frontierOld == 0u && state.started == samples) {
+            // (SPEC §3 mean, clamped on output.)
+            bool unbounded;
+            float bound = addStep(state, float(samples), unbounded);
+            float estimate = estimateError(state, float(samples));
+            bool certified = bound <= tolerance;
+            bool settled = frame.estimate != 0u && unbounded && estimate <= tolerance &&
+                           (state.amplified == 0u || estimate <= frame.localRadiance.w);
+            // The next rung: the highest that traces a ray this step left,
+            // not under the floor; but a pixel whose trees gained weight
+            // goes on below it, until its diverging channels saturate or
+            // its trees reach the budget (SPEC §4 amplifying materials; as
+            // CpuRenderer::renderPixel does).
+            float heaviest = state.cutOff.y;
+            bool belowFloor = AMPLIFYING && unbounded && state.amplified != 0u && pixelBudget != 0u;
+            // (Below the floor it steps 16x at a time: such a pixel goes on
+            // to the budget or saturation anyway, and fewer steps cost less.)
+            float next = belowFloor ? cutOffRung(heaviest) / 16.0 : max(floorCutOff, cutOffRung(heaviest));
+            if (tolerance > 0.0 && !certified && !settled && heaviest > 0.0 && next > 0.0 && next <= heaviest &&
+                state.overBudget == 0u) {
+                cutOff = next;
+                state.deferred.rgb = vec3(0.0);
+                state.cutOff.y = 0.0;
+                state.frontierOld = state.frontierCount;
+            } else {
+                bool overTolerance = tolerance > 0.0 && !certified && !settled;
+                outputPixels[state.pixel] = OutputPixel(
+                    vec4(state.lower.rgb, unbounded ? -bound : bound),
+                    vec4(settled ? estimate : -1.0, float(state.overBudget), overTolerance ? 1.0 : 0.0, 0.0));
+                uint finished = state.finished + 1u;
+                uint rays = state.rays;
+                uint nextPixel = state.pixel + slots;
+                state = freshPixel;
+                state.finished = finished;
+                state.rays = rays;
+                state.pixel = nextPixel;
+                slotStates[slot].finished = finished;
+                slotStates[slot].rays = rays + shadowRays;
+                pixel += uvec2(tile.stepX, tile.stepY);
+                if (pixel.x >= tile.width) pixel += uvec2(-tile.width, 1u);
+                cutOff = firstCutOff;
+                done = state.pixel >= tilePixels;
+            }
+        }
         if (!done && !hasRay) {
             if (state.pending > 0u) {
                 ray = popRay(slot, state.pending);
@@ -721,52 +768,7 @@ void main() {
                 state.frontierCount--;
                 state.frontierOld--;
                 hasRay = true;
-            } else if (state.started == samples) {
-                // A step of the pixel is finished: what it proves (SPEC §3 mean,
-                // clamped on output), and whether a lower cut-off is worth it.
-                bool unbounded;
-                float bound = addStep(state, float(samples), unbounded);
-                float estimate = estimateError(state, float(samples));
-                bool certified = bound <= tolerance;
-                bool settled = frame.estimate != 0u && unbounded && estimate <= tolerance &&
-                               (state.amplified == 0u || estimate <= frame.localRadiance.w);
-                // The next rung: the highest that traces a ray this step left,
-                // not under the floor; but a pixel whose trees gained weight
-                // goes on below it, until its diverging channels saturate or
-                // its trees reach the budget (SPEC §4 amplifying materials; as
-                // CpuRenderer::renderPixel does).
-                float heaviest = state.cutOff.y;
-                bool belowFloor = AMPLIFYING && unbounded && state.amplified != 0u && pixelBudget != 0u;
-                // (Below the floor it steps 16x at a time: such a pixel goes on
-                // to the budget or saturation anyway, and fewer steps cost less.)
-                float next = belowFloor ? cutOffRung(heaviest) / 16.0 : max(floorCutOff, cutOffRung(heaviest));
-                if (tolerance > 0.0 && !certified && !settled && heaviest > 0.0 && next > 0.0 && next <= heaviest &&
-                    state.overBudget == 0u) {
-                    cutOff = next;
-                    state.deferred.rgb = vec3(0.0);
-                    state.cutOff.y = 0.0;
-                    state.frontierOld = state.frontierCount;
-                } else {
-                    bool overTolerance = tolerance > 0.0 && !certified && !settled;
-                    outputPixels[state.pixel] = OutputPixel(
-                        vec4(state.lower.rgb, unbounded ? -bound : bound),
-                        vec4(settled ? estimate : -1.0, float(state.overBudget), overTolerance ? 1.0 : 0.0, 0.0));
-                    uint finished = state.finished + 1u;
-                    uint rays = state.rays;
-                    uint nextPixel = state.pixel + slots;
-                    state = freshPixel;
-                    state.finished = finished;
-                    state.rays = rays;
-                    state.pixel = nextPixel;
-                    slotStates[slot].finished = finished;
-                    slotStates[slot].rays = rays + shadowRays;
-                    pixel += uvec2(tile.stepX, tile.stepY);
-                    if (pixel.x >= tile.width) pixel += uvec2(-tile.width, 1u);
-                    cutOff = firstCutOff;
-                    done = state.pixel >= tilePixels;
-                }
-            }
-            if (!done && !hasRay && state.started < samples) {
+            } else if (state.started < samples) {
                 ray = cameraRay(pixel + uvec2(tile.originX, tile.originY), frame.firstSample + state.started);
                 state.started++;
                 hasRay = true;
