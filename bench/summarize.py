@@ -3,10 +3,12 @@
 
     python3 bench/summarize.py bench/results/bench.json [--plot bench/results/bench.png]
 
-prints the Markdown tables of docs/performance.md and, with --plot, draws
+prints the Markdown tables of docs/performance.md (with the price of the
+default: its time over that of the fastest fixed tree as accurate) and, with --plot, draws
 speed against error: a panel per scene, dispatch time (ms) against the mean
 error (in 1/255) of each setting measured against the limit reference (dots,
-each named, the default ringed, the Pareto front drawn) and against the mean
+each named, the default ringed; the fixed trees the default is priced against
+in red, their Pareto front drawn) and against the mean
 error the render itself guarantees, its stated truncation bound (triangles;
 none where the scene's bound is not finite) (matplotlib, Debian's
 python3-matplotlib)."""
@@ -49,6 +51,8 @@ def tables(d):
               f"{ms(f['dispatch_ms']['median']) if f else '–'} | "
               f"{(format(f['error']['mean_abs_error'], '.3f')) if f else '–'} |")
 
+    prices(d)
+
     print("\n| hard case | fp32 mean | fp32 max | fp32 bad % | fp32 ms | fp64 mean | fp64 max | fp64 bad % | fp64 ms |")
     print("|---|---|---|---|---|---|---|---|---|")
     for scene, settings in by.items():
@@ -90,6 +94,41 @@ def tables(d):
               f"({f['empty_scene_ms'] / f['store_kernel_ms']:.1f}×).")
 
 
+def price(p):
+    """The price of the default as printed: "1.23×", or "< 0.85×" where no fixed tree tried was as accurate."""
+    if p.get("price") is None:
+        return "–"
+    return ("< " if p["price_is_upper_bound"] else "") + f"{p['price']:.3g}×"
+
+
+def prices(d):
+    """The price of the default: its dispatch time over that of the fastest fixed tree (tolerance 0: a weight
+    cut-off 4^-k or a depth cap) whose measured error is no worse (mean, and pixels off by more than 3/255)."""
+    if not d.get("prices"):
+        return
+    print("\n| scene | default ms | price of the default | fixed tree that sets it | its ms | "
+          "default mean / bad | fixed mean / bad | certified / estimated / unbounded (not estimated) pixels |")
+    print("|---|---|---|---|---|---|---|---|")
+    for p in d["prices"]:
+        n = p["pixels"]
+        fixed = p["fixed_setting"] or "–"
+        if p["price_is_upper_bound"] and p["fixed_setting"]:
+            fixed = f"none as accurate (slowest tried: {fixed})"
+        fixed_error = ("–" if p["fixed_mean_abs_error"] is None
+                       else f"{p['fixed_mean_abs_error']:.3f} / {p['fixed_bad_pixels']}")
+        print(f"| {p['scene']} | {ms(p['default_ms'])} | {price(p)} | {fixed} | {ms(p['fixed_ms'])} | "
+              f"{p['default_mean_abs_error']:.3f} / {p['default_bad_pixels']} | {fixed_error} | "
+              f"{n['certified']} / {n['estimated']} / {n['unbounded_not_estimated']} of {n['total']} |")
+    s = d.get("price_summary") or {}
+    if s.get("geometric_mean") is not None:
+        bounds = (f" ({s['upper_bounds']} of them upper bounds, so the mean is one too)"
+                  if s["upper_bounds"] else "")
+        worst = ("< " if s["worst_is_upper_bound"] else "") + f"{s['worst_price']:.3g}×"
+        print(f"\nPrice of the default: geometric mean {'< ' if s['upper_bounds'] else ''}"
+              f"{s['geometric_mean']:.3g}× over {s['scenes']} scenes{bounds}; worst {worst} on "
+              f"{s['worst_scene']} ({s['worst_fixed_setting']}).")
+
+
 def pareto(points):
     """The points no faster point is as accurate as, fastest first."""
     front, best = [], math.inf
@@ -113,22 +152,37 @@ def plot(d, path, only=None):
         if r["scene"] not in scenes:
             scenes.append(r["scene"])
     floor = 1e-3  # an exact result still needs a place on a log axis
+    prices_of = {p["scene"]: p for p in d.get("prices", [])}
+    setters = {p["scene"]: p["fixed_setting"] for p in d.get("prices", []) if not p["price_is_upper_bound"]}
     columns = min(4, len(scenes))
     rows = math.ceil(len(scenes) / columns)
     fig, axes = plt.subplots(rows, columns, figsize=(4.2 * columns, 3.4 * rows), squeeze=False)
     for ax in axes.flat[len(scenes):]:
         ax.set_visible(False)
     for ax, scene in zip(axes.flat, scenes):
-        points = [(r["dispatch_ms"]["median"], max(r["error"]["mean_abs_error"], floor), r["setting"])
-                  for r in results if r["scene"] == scene]
-        front = pareto(points)
-        ax.plot([p[0] for p in front], [p[1] for p in front], color="tab:red", lw=1, zorder=1, label="Pareto front")
-        for t, e, name in points:
+        points = [(r["dispatch_ms"]["median"], max(r["error"]["mean_abs_error"], floor), r["setting"],
+                   r.get("front", False)) for r in results if r["scene"] == scene]
+        # The front: the fixed trees' (older files without them: every setting's).
+        fixed = [p for p in points if p[3]]
+        front = pareto(fixed or points)
+        ax.plot([p[0] for p in front], [p[1] for p in front], color="tab:red", lw=1, zorder=1,
+                label="front of the fixed trees")
+        setter = setters.get(scene)
+        for t, e, name, in_front in points:
             default = name == "default"
+            if in_front:  # a fixed tree: named only where it sets the price
+                ax.scatter([t], [e], s=10, zorder=2, color="tab:red", linewidths=0)
+                if name == setter:
+                    ax.annotate(name, (t, e), fontsize=6, xytext=(3, -7), textcoords="offset points",
+                                color="tab:red")
+                continue
             ax.scatter([t], [e], s=60 if default else 14, zorder=2,
                        facecolors="none" if default else "tab:blue", edgecolors="tab:blue",
                        linewidths=1.5 if default else 0.5)
             ax.annotate(name, (t, e), fontsize=6, xytext=(3, 2), textcoords="offset points")
+        if scene in prices_of:
+            ax.text(0.98, 0.97, f"price of the default {price(prices_of[scene])}", transform=ax.transAxes,
+                    fontsize=7, ha="right", va="top")
         # What each setting guarantees: its stated bound (mean over pixels),
         # where no pixel's bound is infinite.
         stated = [(r["dispatch_ms"]["median"], max(r["stated_bound"]["mean"], floor))
@@ -150,10 +204,11 @@ def plot(d, path, only=None):
         ax.tick_params(labelsize=7)
         ax.grid(True, which="major", lw=0.3, alpha=0.5)
     fig.suptitle(f"snell bench: time against error, {d['size']}² — {d['device']}\n"
-                 f"dots: measured against the limit, ringed: the default settings, red: their Pareto front; "
-                 f"green triangles: the stated (guaranteed) bound; values below {floor} drawn at {floor}",
-                 fontsize=11)
-    fig.tight_layout(rect=(0, 0, 1, 0.96))
+                 f"dots: measured against the limit; blue: the named settings, ringed: the default\n"
+                 f"red: the fixed trees (cut-offs 4^-k, depth caps), their Pareto front, the one that prices the "
+                 f"default named\ngreen triangles: the stated (guaranteed) bound; values below {floor} drawn at {floor}",
+                 fontsize=11 if columns >= 4 else 8)
+    fig.tight_layout(rect=(0, 0, 1, 0.92 if rows > 1 else 0.8))
     fig.savefig(path, dpi=90)
 
 

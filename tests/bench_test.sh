@@ -1,9 +1,11 @@
 #!/usr/bin/env bash
 # `snell bench --quick` works and its numbers are sane: the CSV and JSON are
 # written; every setting rendered, with a positive time and finite error; the
-# default settings stay within 0.5/255 of the exact image; the ceiling, the
-# floor, the peers and the scaling curve are there; bench/summarize.py makes
-# its tables and plot from them. Not a timed test.
+# default settings stay within 0.5/255 of the exact image; every scene has a
+# price of the default (finite and positive, or flagged an upper bound) set by
+# a fixed tree of the front, and the summary its geometric mean; the ceiling,
+# the floor, the peers and the scaling curve are there; bench/summarize.py
+# makes its tables and plot from them. Not a timed test.
 set -u
 : "${SNELL:?}" "${SOURCE:?}" "${PYTHON:=python3}"
 out=$(mktemp -d)
@@ -16,6 +18,9 @@ for f in bench.csv bench.json; do [ -s "$out/$f" ] || { echo "FAIL: no $f"; exit
   { echo "FAIL: bench/summarize.py"; exit 1; }
 [ "$(head -c 4 "$out/bench.png" | od -An -c | tr -d ' ')" = "211PNG" ] || { echo "FAIL: no plot"; exit 1; }
 grep -q "^| bench/simple" "$out/tables.md" || { echo "FAIL: no table row for bench/simple"; exit 1; }
+grep -q "^| scene | default ms | price of the default" "$out/tables.md" || { echo "FAIL: no price table"; exit 1; }
+grep -q "^Price of the default: geometric mean" "$out/tables.md" || { echo "FAIL: no price summary"; exit 1; }
+grep -q "^price of the default: geometric mean" "$out/log" || { echo "FAIL: no price summary in the log"; exit 1; }
 "$PYTHON" - "$out" <<'PY'
 import csv, json, sys, os
 out = sys.argv[1]
@@ -45,6 +50,35 @@ for p in d["peers"]:
 if [s["spheres"] for s in d["scaling"]] != [10, 100, 1000, 10000]: fail.append("scaling counts")
 for s in d["scaling"]:
     if not s["render_ms"]["median"] > 0: fail.append(f"scaling {s}")
+# The price of the default, per scene: its time over the fastest fixed tree's
+# as accurate, or (flagged) an upper bound where no fixed tree tried was.
+import math
+settings = {(r["scene"], r["setting"]): r for r in d["results"]}
+prices = {p["scene"]: p for p in d["prices"]}
+if set(prices) != scenes: fail.append(f"prices for {sorted(prices)}, scenes {sorted(scenes)}")
+for scene, p in prices.items():
+    price = p["price"]
+    if not (price is not None and math.isfinite(price) and price > 0):
+        if not p["price_is_upper_bound"]: fail.append(f"{scene}: price {price}, not an upper bound")
+        continue
+    fixed = settings.get((scene, p["fixed_setting"]))
+    if not fixed or not fixed["front"] or fixed["tolerance"] != 0:
+        fail.append(f"{scene}: price set by {p['fixed_setting']!r}, not a fixed tree of the front"); continue
+    default = settings[(scene, "default")]
+    if abs(price - p["default_ms"] / fixed["dispatch_ms"]["median"]) > 1e-3 * price:
+        fail.append(f"{scene}: price {price} is not default/fixed time")
+    as_accurate = (fixed["error"]["mean_abs_error"] <= default["error"]["mean_abs_error"]
+                   and fixed["error"]["bad_pixels"] <= default["error"]["bad_pixels"])
+    if as_accurate == p["price_is_upper_bound"]:
+        fail.append(f"{scene}: {p['fixed_setting']} as accurate: {as_accurate}, upper bound: {p['price_is_upper_bound']}")
+    n = p["pixels"]
+    if n["total"] != d["size"] ** 2 or n["certified"] + n["estimated"] > n["total"]:
+        fail.append(f"{scene}: pixel counts {n}")
+    if not any(r["front"] for (s, _), r in settings.items() if s == scene): fail.append(f"{scene}: no fixed trees")
+s = d["price_summary"]
+if not (s["geometric_mean"] is not None and math.isfinite(s["geometric_mean"]) and s["geometric_mean"] > 0):
+    fail.append(f"price summary {s}")
+elif s["worst_scene"] not in prices: fail.append(f"worst scene {s['worst_scene']}")
 for f in fail: print("FAIL:", f)
 print(f"bench: {len(d['results'])} settings checked, {len(fail)} problems")
 sys.exit(1 if fail else 0)

@@ -70,6 +70,7 @@ struct Setting {
     double minWeight = kDefaultSettings.minWeight;
     double tolerance = kDefaultSettings.tolerance;  // 0: a fixed cut-off
     int supersample = 0;  // 0: the scene's
+    bool front = false;   // one of the fixed trees the default is priced against (fixedSweep)
 };
 
 struct Result {
@@ -287,187 +288,428 @@ std::vector<SceneFile> collectScenes(const BenchOptions& o) {
     return out;
 }
 
-}  // namespace
+// One scene at one size: the exact image every setting is measured against,
+// and the renderers of its settings (one per precision and BVH mode).
+struct SceneRun {
+    vk::Context& context;
+    const Scene& scene;
+    std::string name, group;
+    RenderRequest base;
+    const Image& exact;
+    int runs = 5;
+    const std::atomic<bool>* cancel = nullptr;
+    std::map<std::pair<int, int>, std::unique_ptr<ComputeRenderer>> renderers;
 
-void runBench(const BenchOptions& o, std::ostream& log) {
-    const int size = o.size > 0 ? o.size : (o.quick ? 48 : 128);
-    const int runs = std::max(5, o.runs);
-    fs::create_directories(o.outDir);
-    const std::vector<SceneFile> files = collectScenes(o);
-    if (files.empty()) throw BenchError("no scenes to benchmark");
+    // A warm-up, `runs` timed renders and one that counts the rays; the error
+    // of the first timed image against the exact one.
+    Result measure(const Setting& setting);
+};
 
-    vk::ContextOptions contextOptions;
-    contextOptions.deviceIndex = o.gpu;
-    vk::Context context(contextOptions);
-    const std::string device = context.deviceName() + " (" + context.driverInfo() + ")";
-    log << "bench: " << files.size() << " scenes at " << size << "x" << size << ", " << runs
-        << " timed runs per setting, on " << device
-        << (context.timestampsSupported() ? "" : "; no GPU timestamps: host timing") << "\n";
-
-    const auto ceilingStart = Clock::now();
-    const Ceiling ceiling = measureCeiling(context, runs, o.quick);
-    log << "ceiling: " << ceiling.centreRadius * 1e-9 << " G ray-sphere tests/s (centre+radius), "
-        << ceiling.matrix * 1e-9 << " G (inverse matrix); floor at " << ceiling.floorSize << "²: store-only kernel "
-        << number(ceiling.storeMs) << " ms, empty scene " << number(ceiling.emptySceneMs) << " ms; "
-        << msSince(ceilingStart) / 1000 << " s\n";
-
-    auto cancelled = [&] { return o.cancel && o.cancel->load(); };
-    std::vector<Result> results;
-    std::vector<Peer> peers;
-    std::map<std::string, double> referenceMs, cpuDefaultMs;
-    for (const SceneFile& file : files) {
-        if (cancelled()) throw BenchError("cancelled");
-        const Scene scene = parseSceneFile(file.path);
-        const std::string name = file.group + "/" + scene.name;
-        RenderRequest base;
-        base.width = base.height = size;
-        base.supersample = scene.supersample;
-        base.camera = Camera::fromSpec(size, scene.halfWidth);
-        base.cancel = o.cancel;
-        base.trace = kDefaultSettings;
-
-        // The exact image: the limit reference (SPEC §4; render/Truncation.h).
-        RenderRequest exactRequest = base;
-        exactRequest.trace = kReferenceSettings;
-        const CpuRenderer cpu(scene);
-        const auto cpuStart = Clock::now();
-        const Image exact = cpu.render(exactRequest);
-        referenceMs[name] = msSince(cpuStart);
-        // The CPU reference again, at the GPU's default settings: a peer at equal work.
-        RenderRequest sameRequest = base;
-        sameRequest.trace = kDefaultSettings;
-        const auto sameStart = Clock::now();
-        cpu.render(sameRequest);
-        cpuDefaultMs[name] = msSince(sameStart);
-
-        std::map<std::pair<int, int>, std::unique_ptr<ComputeRenderer>> renderers;
-        const std::vector<Setting> settings = settingsFor(scene, o.quick);
-        for (const Setting& setting : settings) {
-            Result r;
-            r.scene = name;
-            r.group = file.group;
-            r.setting = setting;
-            r.size = size;
-            r.spheres = int(scene.spheres.size());
-            RenderRequest request = base;
-            request.trace.maxDepth = setting.depth;
-            request.trace.minWeight = setting.minWeight;
-            request.trace.tolerance = setting.tolerance;
-            request.truncation = &r.bound;
-            if (setting.supersample) request.supersample = setting.supersample;
-            r.supersample = request.supersample;
-            try {
-                auto& renderer = renderers[{int(setting.precision), int(setting.bvh)}];
-                if (!renderer)
-                    renderer = std::make_unique<ComputeRenderer>(context, scene, base.camera, setting.precision,
-                                                                 setting.bvh);
-                r.bvhUsed = renderer->layout().usesBvh();
-                renderer->render(request, false);  // warm-up: pipeline and first dispatch
-                std::vector<double> ms;
-                Image image;
-                for (int k = 0; k < runs; ++k) {
-                    GpuRenderResult g = renderer->render(request, false);
-                    ms.push_back(g.renderMs);
-                    r.gpuTimed = g.gpuTimed;
-                    if (k == 0) image = std::move(g.image);
-                }
-                r.dispatchMs = stats(ms);
-                r.rays = renderer->render(request, true).rays;
-                r.error = compareImages(image, exact);
-            } catch (const vk::VulkanError& e) {
-                if (cancelled()) throw;
-                r.failure = e.what();
-            }
-            results.push_back(r);
+Result SceneRun::measure(const Setting& setting) {
+    Result r;
+    r.scene = name;
+    r.group = group;
+    r.setting = setting;
+    r.size = base.width;
+    r.spheres = int(scene.spheres.size());
+    RenderRequest request = base;
+    request.trace.maxDepth = setting.depth;
+    request.trace.minWeight = setting.minWeight;
+    request.trace.tolerance = setting.tolerance;
+    request.truncation = &r.bound;
+    if (setting.supersample) request.supersample = setting.supersample;
+    r.supersample = request.supersample;
+    try {
+        auto& renderer = renderers[{int(setting.precision), int(setting.bvh)}];
+        if (!renderer)
+            renderer = std::make_unique<ComputeRenderer>(context, scene, base.camera, setting.precision, setting.bvh);
+        r.bvhUsed = renderer->layout().usesBvh();
+        renderer->render(request, false);  // warm-up: pipeline and first dispatch
+        std::vector<double> ms;
+        Image image;
+        for (int k = 0; k < runs; ++k) {
+            GpuRenderResult g = renderer->render(request, false);
+            ms.push_back(g.renderMs);
+            r.gpuTimed = g.gpuTimed;
+            if (k == 0) image = std::move(g.image);
         }
-        const Result& def = results[results.size() - settings.size()];
-        log << name << ": default " << number(def.dispatchMs.median) << " ms, error "
-            << number(def.error.meanAbsError) << "/255; CPU reference " << number(referenceMs[name])
-            << " ms converged, " << number(cpuDefaultMs[name]) << " ms at the default settings\n";
-
-        // Peers on the shared bench scenes: depth 5, no cut-off, at the scene's own size.
-        if (file.group != "bench") continue;
-        Peer peer;
-        peer.scene = name;
-        peer.size = o.quick ? size : scene.imageSize;
-        RenderRequest request = base;
-        request.width = request.height = peer.size;
-        request.camera = Camera::fromSpec(peer.size, scene.halfWidth);
-        request.trace.maxDepth = 5;
-        request.trace.minWeight = 0.0;
-        request.trace.tolerance = 0.0;
-        {
-            ComputeRenderer renderer(context, scene, request.camera);
-            renderer.render(request, false);
-            std::vector<double> ms;
-            for (int k = 0; k < runs; ++k) ms.push_back(renderer.render(request, false).renderMs);
-            peer.snellDispatchMs = stats(ms).median;
-        }
-        {
-            const auto start = Clock::now();
-            cpu.render(request);
-            peer.cpuMs = msSince(start);
-        }
-        const std::string output = (fs::path(o.outDir) / "peer.png").string();
-        const std::string common = quote(file.path) + " --size " + std::to_string(peer.size) +
-                                   " --depth 5 --min-weight 0 -q -o " + quote(output);
-        if (!o.snellPath.empty()) {
-            const std::string cache = (fs::path(o.outDir) / "pipeline-cache").string();
-            fs::remove_all(cache);
-            const std::string env = "SNELL_CACHE_DIR=" + quote(cache) + " ";
-            peer.coldMs = runCommand(env + quote(o.snellPath) + " render " + common);
-            peer.warmMs = runCommand(env + quote(o.snellPath) + " render " + common);
-            std::vector<double> ms;
-            for (int k = 0; k < runs; ++k) ms.push_back(runCommand(env + quote(o.snellPath) + " render " + common));
-            peer.snellCommandMs = stats(ms).median;
-            fs::remove_all(cache);
-        }
-        fs::remove(output);
-        if (std::system("command -v povray >/dev/null 2>&1") == 0) {
-            const std::string pov = (fs::path(o.outDir) / (scene.name + ".pov")).string();
-            std::ofstream(pov) << toPovRay(scene, 5);
-            const std::string povOut = (fs::path(o.outDir) / "pov.png").string();
-            const std::string command = "povray +I" + quote(pov) + " +O" + quote(povOut) + " +W" +
-                                        std::to_string(peer.size) + " +H" + std::to_string(peer.size) +
-                                        " -D -A +Q9 +WT2";
-            std::vector<double> trace, whole;
-            try {
-                for (int k = 0; k < std::max(3, runs / 2); ++k) {
-                    std::string text;
-                    whole.push_back(runCommand(command, &text));
-                    // "Trace Time:       0 hours  0 minutes  0 seconds (0.161 seconds)"
-                    const std::size_t at = text.find("Trace Time:");
-                    const std::size_t open = at == std::string::npos ? at : text.find('(', at);
-                    if (open == std::string::npos) throw BenchError("POV-Ray printed no trace time");
-                    trace.push_back(std::atof(text.c_str() + open + 1) * 1000.0);
-                }
-                peer.povTraceMs = stats(trace).median;
-                peer.povCommandMs = stats(whole).median;
-            } catch (const BenchError& e) {
-                peer.povNote = e.what();
-            }
-            fs::remove(povOut);
-            fs::remove(pov);
-        } else {
-            peer.povNote = "povray is not installed (apt-get install povray)";
-        }
-        log << "  peers at " << peer.size << "x" << peer.size << ", depth 5: snell dispatch "
-            << number(peer.snellDispatchMs) << " ms, command " << number(peer.snellCommandMs) << " ms (cold "
-            << number(peer.coldMs) << ", warm " << number(peer.warmMs) << "); CPU reference " << number(peer.cpuMs)
-            << " ms; POV-Ray trace "
-            << (peer.povTraceMs ? number(*peer.povTraceMs) + " ms, command " + number(*peer.povCommandMs) + " ms"
-                                : peer.povNote)
-            << "\n";
-        peers.push_back(peer);
+        r.dispatchMs = stats(ms);
+        r.rays = renderer->render(request, true).rays;
+        r.error = compareImages(image, exact);
+    } catch (const vk::VulkanError& e) {
+        if (cancel && cancel->load()) throw;
+        r.failure = e.what();
     }
+    return r;
+}
 
-    // Scaling: render time against sphere count at 512² (quick: 64²).
+// The price of the default: what its certified trees cost against fixed
+// trees (tolerance 0) that are as accurate, measured against the exact image:
+// no larger mean error and no more pixels off by more than 3/255.
+bool asAccurate(const Result& r, const Result& def) {
+    return r.failure.empty() && r.error.meanAbsError <= def.error.meanAbsError &&
+           r.error.badPixels <= def.error.badPixels;
+}
+
+// A fixed series stops after a tree slower than this many times the default
+// (none later can set the price), and before a depth cap whose tree may hold
+// more rays than kFixedRayLimit, or after one that traced more than
+// kFixedRayRatio times the default's rays.
+constexpr double kFixedTimeRatio = 4.0;
+constexpr double kFixedRayLimit = 50e6;
+constexpr double kFixedRayRatio = 4.0;
+
+constexpr int kLastCutOff = 12, kLastCutOffQuick = 6;  // cut-offs 4^-1 .. 4^-k
+constexpr int kLastDepth = 16, kLastDepthQuick = 5;     // depth caps 1 .. d
+
+// Whether `s` is one of the fixed trees the default is priced against:
+// a cut-off 4^-k at the default depth limit, or a depth cap without a
+// cut-off, at the scene's precision, BVH and supersampling.
+bool isFixedTree(const Setting& s, bool quick) {
+    if (s.tolerance != 0.0 || s.precision != gpu::Precision::Fp32 || s.bvh != gpu::BvhMode::Auto || s.supersample)
+        return false;
+    if (s.minWeight == 0.0) return s.depth >= 1 && s.depth <= (quick ? kLastDepthQuick : kLastDepth);
+    int exponent = 0;
+    const double mantissa = std::frexp(s.minWeight, &exponent);  // 4^-k = 0.5 · 2^(1 - 2k)
+    const int k = (1 - exponent) / 2;
+    return s.depth == kDefaultSettings.maxDepth && mantissa == 0.5 && (1 - exponent) % 2 == 0 && k >= 1 &&
+           k <= (quick ? kLastCutOffQuick : kLastCutOff);
+}
+
+Setting fixedSetting(const std::string& name, int depth, double minWeight) {
+    Setting s{name};
+    s.depth = depth;
+    s.minWeight = minWeight;
+    s.tolerance = 0.0;
+    s.front = true;
+    return s;
+}
+
+// The index of `setting`'s result among this scene's (from `first` on): one
+// measured already with the same parameters (the named depth sweep), else
+// measured now.
+std::size_t measureOnce(SceneRun& run, std::vector<Result>& results, std::size_t first, const Setting& setting) {
+    for (std::size_t i = first; i < results.size(); ++i) {
+        Setting& s = results[i].setting;
+        if (s.precision == setting.precision && s.bvh == setting.bvh && s.depth == setting.depth &&
+            s.minWeight == setting.minWeight && s.tolerance == setting.tolerance &&
+            s.supersample == setting.supersample) {
+            s.front = true;
+            return i;
+        }
+    }
+    results.push_back(run.measure(setting));
+    return results.size() - 1;
+}
+
+// One series of fixed trees, in order of growing cost: next(k, previous)
+// gives the k-th setting (k = 1, 2, ...), or nothing where the series ends
+// before it. The series also ends after a tree as accurate as the default
+// (the later ones are slower), one slower than kFixedTimeRatio times the
+// default, or one that failed. Adds the indices of the trees measured.
+template <class Next>
+void sweepSeries(SceneRun& run, std::vector<Result>& results, std::size_t def, Next next,
+                 std::vector<std::size_t>& tried) {
+    std::optional<std::size_t> previous;
+    for (int k = 1;; ++k) {
+        const std::optional<Setting> setting = next(k, previous ? &results[*previous] : nullptr);
+        if (!setting) return;
+        const std::size_t i = measureOnce(run, results, def, *setting);
+        const Result& r = results[i];
+        if (!r.failure.empty()) return;
+        if (std::find(tried.begin(), tried.end(), i) == tried.end()) tried.push_back(i);
+        if (asAccurate(r, results[def]) || r.dispatchMs.median > kFixedTimeRatio * results[def].dispatchMs.median)
+            return;
+        previous = i;
+    }
+}
+
+// The fixed trees the default is priced against (isFixedTree): (a) weight
+// cut-offs 4^-k at the default depth limit and tree budget, k = 1..12
+// (quick: 1..6), and (b) depth caps d = 1..16 (quick: 1..5) without a
+// cut-off. `def` is the index of the scene's default result, its first; the
+// named settings that are fixed trees (depth caps) count without a cost
+// limit, as they are measured anyway. Returns the indices of the trees
+// measured, marked as the front.
+std::vector<std::size_t> fixedSweep(SceneRun& run, std::vector<Result>& results, std::size_t def, bool quick) {
+    std::vector<std::size_t> tried;
+    for (std::size_t i = def; i < results.size(); ++i) {
+        if (!isFixedTree(results[i].setting, quick) || !results[i].failure.empty()) continue;
+        results[i].setting.front = true;
+        tried.push_back(i);
+    }
+    const int lastCutOff = quick ? kLastCutOffQuick : kLastCutOff;
+    sweepSeries(run, results, def, [&](int k, const Result*) -> std::optional<Setting> {
+        if (k > lastCutOff) return std::nullopt;
+        const double w = std::ldexp(1.0, -2 * k);
+        std::ostringstream name;
+        name.precision(3);
+        name << "fixed min-weight " << w;
+        return fixedSetting(name.str(), kDefaultSettings.maxDepth, w);
+    }, tried);
+    const int lastDepth = quick ? kLastDepthQuick : kLastDepth;
+    const double samples = double(run.base.width) * run.base.height * run.base.supersample * run.base.supersample;
+    const double defaultRays = double(results[def].rays.total());
+    sweepSeries(run, results, def, [&](int d, const Result* previous) -> std::optional<Setting> {
+        if (d > lastDepth) return std::nullopt;
+        // Without a cut-off a branching scene's tree doubles with each level.
+        if (std::exp2(treeSizeBound(run.scene, d, 0.0).log2Rays) * samples > kFixedRayLimit) return std::nullopt;
+        if (previous && double(previous->rays.total()) > kFixedRayRatio * defaultRays) return std::nullopt;
+        return fixedSetting("fixed depth " + std::to_string(d), d, 0.0);
+    }, tried);
+    return tried;
+}
+
+// What the default costs: its dispatch time over the fastest fixed tree's as
+// accurate (asAccurate). Where no tree tried is, the price is below the
+// default's time over the slowest tried's: an upper bound.
+struct Price {
+    std::string scene;
+    double defaultMs = NAN, defaultMean = NAN;
+    std::uint64_t defaultBad = 0;
+    double price = NAN;  // NaN: no fixed tree measured
+    bool upperBound = false;
+    std::string fixed;  // the fixed tree that sets the price (or the bound)
+    double fixedMs = NAN, fixedMean = NAN;
+    std::uint64_t fixedBad = 0;
+    int tried = 0;  // fixed trees measured
+    // The default's pixels by how they stopped (render/Truncation.h): within
+    // the tolerance (certified), by an estimated error, and those whose lost
+    // light has no finite bound and that no estimate stopped; besides these,
+    // bounded pixels above the tolerance at the floor or the tree budget.
+    std::uint64_t pixels = 0, certified = 0, estimated = 0, unboundedNotEstimated = 0, overTolerance = 0,
+                  overBudget = 0;
+};
+
+Price priceOf(const std::vector<Result>& results, std::size_t def, const std::vector<std::size_t>& tried) {
+    const Result& d = results[def];
+    Price p;
+    p.scene = d.scene;
+    p.defaultMs = d.dispatchMs.median;
+    p.defaultMean = d.error.meanAbsError;
+    p.defaultBad = d.error.badPixels;
+    const TruncationReport& t = d.bound;
+    p.pixels = t.pixels;
+    p.estimated = t.estimated;
+    p.overTolerance = t.overTolerance;
+    p.overBudget = t.overBudget;
+    // An estimated pixel is not over the tolerance; every other pixel is certified.
+    p.certified = t.pixels - std::min(t.pixels, t.estimated + t.overTolerance);
+    p.unboundedNotEstimated = t.unbounded - std::min(t.unbounded, t.estimated);
+    p.tried = int(tried.size());
+    std::optional<std::size_t> fastest, slowest;
+    for (std::size_t i : tried) {
+        const double ms = results[i].dispatchMs.median;
+        if (asAccurate(results[i], d) && (!fastest || ms < results[*fastest].dispatchMs.median)) fastest = i;
+        if (!slowest || ms > results[*slowest].dispatchMs.median) slowest = i;
+    }
+    const std::optional<std::size_t> setter = fastest ? fastest : slowest;
+    if (!setter) return p;
+    const Result& f = results[*setter];
+    p.upperBound = !fastest;
+    p.price = p.defaultMs / f.dispatchMs.median;
+    p.fixed = f.setting.name;
+    p.fixedMs = f.dispatchMs.median;
+    p.fixedMean = f.error.meanAbsError;
+    p.fixedBad = f.error.badPixels;
+    return p;
+}
+
+std::string brief(double v) {  // three significant digits, for the log
+    std::ostringstream s;
+    s.precision(3);
+    s << v;
+    return s.str();
+}
+
+// "price of the default 1.23x (fixed min-weight 0.00391: 12.3 ms, mean 0.02/255, 3 bad); ..."
+std::string describe(const Price& p) {
+    std::ostringstream s;
+    if (std::isnan(p.price)) {
+        s << "price of the default: no fixed tree measured";
+    } else {
+        s << "price of the default " << (p.upperBound ? "< " : "") << brief(p.price) << "x ("
+          << (p.upperBound ? "no fixed tree as accurate; slowest tried " : "") << p.fixed << ": "
+          << brief(p.fixedMs) << " ms, mean " << brief(p.fixedMean) << "/255, " << p.fixedBad << " bad)";
+    }
+    s << "; default mean " << brief(p.defaultMean) << "/255, " << p.defaultBad << " bad; pixels " << p.certified
+      << " certified, " << p.estimated << " estimated, " << p.unboundedNotEstimated << " unbounded not estimated";
+    if (p.overBudget) s << ", " << p.overBudget << " over budget";
+    s << " of " << p.pixels << "; " << p.tried << " fixed trees tried";
+    return s.str();
+}
+
+// Over the scenes with a price: its geometric mean (an upper bound where
+// some are) and the scene where it is largest.
+struct PriceSummary {
+    double geometricMean = NAN;
+    int scenes = 0, upperBounds = 0;
+    std::optional<Price> worst;
+};
+
+PriceSummary summarizePrices(const std::vector<Price>& prices) {
+    PriceSummary s;
+    double sumLog = 0.0;
+    for (const Price& p : prices) {
+        if (!(p.price > 0.0) || !std::isfinite(p.price)) continue;
+        ++s.scenes;
+        s.upperBounds += p.upperBound;
+        sumLog += std::log(p.price);
+        if (!s.worst || p.price > s.worst->price) s.worst = p;
+    }
+    if (s.scenes) s.geometricMean = std::exp(sumLog / s.scenes);
+    return s;
+}
+
+std::string describe(const PriceSummary& s) {
+    if (!s.worst) return "price of the default: no scene priced";
+    std::ostringstream o;
+    o << "price of the default: geometric mean " << (s.upperBounds ? "< " : "") << brief(s.geometricMean)
+      << "x over " << s.scenes << " scenes";
+    if (s.upperBounds) o << " (" << s.upperBounds << " of them upper bounds)";
+    o << "; worst " << (s.worst->upperBound ? "< " : "") << brief(s.worst->price) << "x on " << s.worst->scene
+      << " (" << s.worst->fixed << ")";
+    return o.str();
+}
+
+// Everything the run measured, for bench.csv and bench.json.
+struct Collected {
+    std::vector<Result> results;
+    std::vector<Price> prices;
+    std::vector<Peer> peers;
+    std::vector<Scaling> scaling;
+    std::map<std::string, double> referenceMs, cpuDefaultMs;
+};
+
+// Peers on the shared bench scenes: depth 5, no cut-off, at the scene's own
+// size (quick: the bench's): the dispatch, the whole `snell render`
+// command, the CPU reference and POV-Ray.
+Peer measurePeer(vk::Context& context, const BenchOptions& o, const SceneFile& file, const Scene& scene,
+                 const CpuRenderer& cpu, const RenderRequest& base, int runs, std::ostream& log) {
+    Peer peer;
+    peer.scene = file.group + "/" + scene.name;
+    peer.size = o.quick ? base.width : scene.imageSize;
+    RenderRequest request = base;
+    request.width = request.height = peer.size;
+    request.camera = Camera::fromSpec(peer.size, scene.halfWidth);
+    request.trace.maxDepth = 5;
+    request.trace.minWeight = 0.0;
+    request.trace.tolerance = 0.0;
+    {
+        ComputeRenderer renderer(context, scene, request.camera);
+        renderer.render(request, false);
+        std::vector<double> ms;
+        for (int k = 0; k < runs; ++k) ms.push_back(renderer.render(request, false).renderMs);
+        peer.snellDispatchMs = stats(ms).median;
+    }
+    {
+        const auto start = Clock::now();
+        cpu.render(request);
+        peer.cpuMs = msSince(start);
+    }
+    const std::string output = (fs::path(o.outDir) / "peer.png").string();
+    const std::string common = quote(file.path) + " --size " + std::to_string(peer.size) +
+                               " --depth 5 --min-weight 0 -q -o " + quote(output);
+    if (!o.snellPath.empty()) {
+        const std::string cache = (fs::path(o.outDir) / "pipeline-cache").string();
+        fs::remove_all(cache);
+        const std::string env = "SNELL_CACHE_DIR=" + quote(cache) + " ";
+        peer.coldMs = runCommand(env + quote(o.snellPath) + " render " + common);
+        peer.warmMs = runCommand(env + quote(o.snellPath) + " render " + common);
+        std::vector<double> ms;
+        for (int k = 0; k < runs; ++k) ms.push_back(runCommand(env + quote(o.snellPath) + " render " + common));
+        peer.snellCommandMs = stats(ms).median;
+        fs::remove_all(cache);
+    }
+    fs::remove(output);
+    if (std::system("command -v povray >/dev/null 2>&1") == 0) {
+        const std::string pov = (fs::path(o.outDir) / (scene.name + ".pov")).string();
+        std::ofstream(pov) << toPovRay(scene, 5);
+        const std::string povOut = (fs::path(o.outDir) / "pov.png").string();
+        const std::string command = "povray +I" + quote(pov) + " +O" + quote(povOut) + " +W" +
+                                    std::to_string(peer.size) + " +H" + std::to_string(peer.size) +
+                                    " -D -A +Q9 +WT2";
+        std::vector<double> trace, whole;
+        try {
+            for (int k = 0; k < std::max(3, runs / 2); ++k) {
+                std::string text;
+                whole.push_back(runCommand(command, &text));
+                // "Trace Time:       0 hours  0 minutes  0 seconds (0.161 seconds)"
+                const std::size_t at = text.find("Trace Time:");
+                const std::size_t open = at == std::string::npos ? at : text.find('(', at);
+                if (open == std::string::npos) throw BenchError("POV-Ray printed no trace time");
+                trace.push_back(std::atof(text.c_str() + open + 1) * 1000.0);
+            }
+            peer.povTraceMs = stats(trace).median;
+            peer.povCommandMs = stats(whole).median;
+        } catch (const BenchError& e) {
+            peer.povNote = e.what();
+        }
+        fs::remove(povOut);
+        fs::remove(pov);
+    } else {
+        peer.povNote = "povray is not installed (apt-get install povray)";
+    }
+    log << "  peers at " << peer.size << "x" << peer.size << ", depth 5: snell dispatch "
+        << number(peer.snellDispatchMs) << " ms, command " << number(peer.snellCommandMs) << " ms (cold "
+        << number(peer.coldMs) << ", warm " << number(peer.warmMs) << "); CPU reference " << number(peer.cpuMs)
+        << " ms; POV-Ray trace "
+        << (peer.povTraceMs ? number(*peer.povTraceMs) + " ms, command " + number(*peer.povCommandMs) + " ms"
+                            : peer.povNote)
+        << "\n";
+    return peer;
+}
+
+// One scene: the exact image (the limit reference, SPEC §4;
+// render/Truncation.h) and the CPU reference at the GPU's default settings
+// (a peer at equal work); the named settings; the fixed trees and the price
+// of the default; the peers on the shared bench scenes.
+void benchScene(vk::Context& context, const BenchOptions& o, const SceneFile& file, int size, int runs,
+                Collected& out, std::ostream& log) {
+    const Scene scene = parseSceneFile(file.path);
+    const std::string name = file.group + "/" + scene.name;
+    RenderRequest base;
+    base.width = base.height = size;
+    base.supersample = scene.supersample;
+    base.camera = Camera::fromSpec(size, scene.halfWidth);
+    base.cancel = o.cancel;
+    base.trace = kDefaultSettings;
+
+    RenderRequest exactRequest = base;
+    exactRequest.trace = kReferenceSettings;
+    const CpuRenderer cpu(scene);
+    const auto cpuStart = Clock::now();
+    const Image exact = cpu.render(exactRequest);
+    out.referenceMs[name] = msSince(cpuStart);
+    const auto sameStart = Clock::now();
+    cpu.render(base);
+    out.cpuDefaultMs[name] = msSince(sameStart);
+
+    SceneRun run{context, scene, name, file.group, base, exact, runs, o.cancel, {}};
+    const std::size_t def = out.results.size();
+    for (const Setting& setting : settingsFor(scene, o.quick)) out.results.push_back(run.measure(setting));
+    {
+        const Result& d = out.results[def];
+        log << name << ": default " << number(d.dispatchMs.median) << " ms, error " << number(d.error.meanAbsError)
+            << "/255; CPU reference " << number(out.referenceMs[name]) << " ms converged, "
+            << number(out.cpuDefaultMs[name]) << " ms at the default settings\n";
+    }
+    std::vector<std::size_t> tried;
+    if (out.results[def].failure.empty()) tried = fixedSweep(run, out.results, def, o.quick);
+    out.prices.push_back(priceOf(out.results, def, tried));
+    log << "  " << describe(out.prices.back()) << "\n";
+
+    if (file.group == "bench") out.peers.push_back(measurePeer(context, o, file, scene, cpu, base, runs, log));
+}
+
+// Render time against sphere count at 512² (quick: 64², up to 10^4 spheres).
+std::vector<Scaling> measureScaling(vk::Context& context, const BenchOptions& o, int runs, std::ostream& log) {
     std::vector<Scaling> scaling;
     const std::string generator = (fs::path(o.sourceDir) / "bench" / "make_scaling_scene.py").string();
     const int maxExponent = o.quick ? 4 : 6;
     const int scalingSize = o.quick ? 64 : 512;
     for (int e = 1; e <= maxExponent; ++e) {
-        if (cancelled()) throw BenchError("cancelled");
+        if (o.cancel && o.cancel->load()) throw BenchError("cancelled");
         Scaling s;
         s.spheres = int(std::lround(std::pow(10.0, e)));
         s.size = scalingSize;
@@ -496,85 +738,172 @@ void runBench(const BenchOptions& o, std::ostream& log) {
             << "², scene on the GPU " << number(s.gpuMiB) << " MiB\n";
         scaling.push_back(s);
     }
+    return scaling;
+}
 
-    // CSV: one row per scene and setting.
-    {
-        std::ofstream csv(fs::path(o.outDir) / "bench.csv");
-        csv << "scene,setting,precision,bvh,depth,min_weight,supersample,size,spheres,dispatch_ms_median,"
-               "dispatch_ms_min,dispatch_ms_max,timing,rays_primary,rays_shadow,rays_reflected,rays_refracted,"
-               "rays_per_s,mean_abs_error,rmse,psnr,bad_fraction,max_error,non_finite,ceiling_fraction,failure\n";
-        for (const Result& r : results) {
-            const double raysPerSecond = r.dispatchMs.median > 0 ? r.rays.total() / (r.dispatchMs.median * 1e-3) : 0;
-            // Ray–sphere tests a second without a BVH, against the micro-kernel.
-            const double ceilingFraction =
-                r.bvhUsed || r.dispatchMs.median <= 0
-                    ? NAN
-                    : (double(r.rays.total()) * r.spheres / (r.dispatchMs.median * 1e-3)) / ceiling.centreRadius;
-            csv << r.scene << ",\"" << r.setting.name << "\","
-                << (r.setting.precision == gpu::Precision::Fp64 ? "fp64" : "fp32") << ","
-                << (r.bvhUsed ? "on" : "off") << "," << r.setting.depth << "," << r.setting.minWeight << ","
-                << r.supersample << "," << r.size << "," << r.spheres << "," << number(r.dispatchMs.median) << ","
-                << number(r.dispatchMs.min) << "," << number(r.dispatchMs.max) << ","
-                << (r.gpuTimed ? "gpu" : "host") << "," << r.rays.primary << "," << r.rays.shadow << ","
-                << r.rays.reflected << "," << r.rays.refracted << "," << number(raysPerSecond) << ","
-                << number(r.error.meanAbsError) << "," << number(r.error.rmse) << "," << number(r.error.psnr) << ","
-                << number(r.error.badFraction) << "," << r.error.maxError << "," << r.error.nonFinite << ","
-                << (std::isnan(ceilingFraction) ? "" : number(ceilingFraction)) << ",\"" << r.failure << "\"\n";
+// bench.csv: one row per scene and setting; the price of the default (and
+// the default's pixels by how they stopped) on the default's row.
+void writeCsv(const fs::path& path, const Collected& c, const Ceiling& ceiling) {
+    std::map<std::string, const Price*> priceOfScene;
+    for (const Price& p : c.prices) priceOfScene[p.scene] = &p;
+    std::ofstream csv(path);
+    csv << "scene,setting,precision,bvh,depth,min_weight,supersample,size,spheres,dispatch_ms_median,"
+           "dispatch_ms_min,dispatch_ms_max,timing,rays_primary,rays_shadow,rays_reflected,rays_refracted,"
+           "rays_per_s,mean_abs_error,rmse,psnr,bad_fraction,max_error,non_finite,ceiling_fraction,failure,"
+           "bad_pixels,front,price,price_is_upper_bound,price_setting,pixels_certified,pixels_estimated,"
+           "pixels_unbounded_not_estimated\n";
+    for (const Result& r : c.results) {
+        const double raysPerSecond = r.dispatchMs.median > 0 ? r.rays.total() / (r.dispatchMs.median * 1e-3) : 0;
+        // Ray–sphere tests a second without a BVH, against the micro-kernel.
+        const double ceilingFraction =
+            r.bvhUsed || r.dispatchMs.median <= 0
+                ? NAN
+                : (double(r.rays.total()) * r.spheres / (r.dispatchMs.median * 1e-3)) / ceiling.centreRadius;
+        csv << r.scene << ",\"" << r.setting.name << "\","
+            << (r.setting.precision == gpu::Precision::Fp64 ? "fp64" : "fp32") << ","
+            << (r.bvhUsed ? "on" : "off") << "," << r.setting.depth << "," << r.setting.minWeight << ","
+            << r.supersample << "," << r.size << "," << r.spheres << "," << number(r.dispatchMs.median) << ","
+            << number(r.dispatchMs.min) << "," << number(r.dispatchMs.max) << ","
+            << (r.gpuTimed ? "gpu" : "host") << "," << r.rays.primary << "," << r.rays.shadow << ","
+            << r.rays.reflected << "," << r.rays.refracted << "," << number(raysPerSecond) << ","
+            << number(r.error.meanAbsError) << "," << number(r.error.rmse) << "," << number(r.error.psnr) << ","
+            << number(r.error.badFraction) << "," << r.error.maxError << "," << r.error.nonFinite << ","
+            << (std::isnan(ceilingFraction) ? "" : number(ceilingFraction)) << ",\"" << r.failure << "\","
+            << r.error.badPixels << "," << (r.setting.front ? 1 : 0) << ",";
+        const auto p = priceOfScene.find(r.scene);
+        if (r.setting.name == "default" && p != priceOfScene.end() && !std::isnan(p->second->price)) {
+            const Price& price = *p->second;
+            csv << number(price.price) << "," << (price.upperBound ? 1 : 0) << ",\"" << price.fixed << "\","
+                << price.certified << "," << price.estimated << "," << price.unboundedNotEstimated << "\n";
+        } else {
+            csv << ",,,,,\n";
         }
     }
-    // JSON: everything, for tools.
-    {
-        std::ofstream json(fs::path(o.outDir) / "bench.json");
-        json << "{\n  \"device\": " << jsonString(device) << ",\n  \"driver\": " << jsonString(context.driverInfo())
-             << ",\n  \"size\": " << size << ",\n  \"runs\": " << runs
-             << ",\n  \"timing\": \"" << (context.timestampsSupported() ? "gpu-timestamps" : "host") << "\""
-             << ",\n  \"ceiling_tests_per_s\": {\"centre_radius\": " << number(ceiling.centreRadius)
-             << ", \"inverse_matrix\": " << number(ceiling.matrix) << "},\n  \"floor\": {\"size\": "
-             << ceiling.floorSize << ", \"store_kernel_ms\": " << number(ceiling.storeMs)
-             << ", \"empty_scene_ms\": " << number(ceiling.emptySceneMs) << "},\n  \"results\": [\n";
-        for (std::size_t i = 0; i < results.size(); ++i) {
-            const Result& r = results[i];
-            json << "    {\"scene\": " << jsonString(r.scene) << ", \"setting\": " << jsonString(r.setting.name)
-                 << ", \"precision\": \"" << (r.setting.precision == gpu::Precision::Fp64 ? "fp64" : "fp32")
-                 << "\", \"bvh\": " << (r.bvhUsed ? "true" : "false") << ", \"depth\": " << r.setting.depth
-                 << ", \"min_weight\": " << number(r.setting.minWeight) << ", \"supersample\": " << r.supersample
-                 << ", \"spheres\": " << r.spheres << ", \"dispatch_ms\": {\"median\": " << number(r.dispatchMs.median)
-                 << ", \"min\": " << number(r.dispatchMs.min) << ", \"max\": " << number(r.dispatchMs.max)
-                 << "}, \"rays\": {\"primary\": " << r.rays.primary << ", \"shadow\": " << r.rays.shadow
-                 << ", \"reflected\": " << r.rays.reflected << ", \"refracted\": " << r.rays.refracted
-                 << "}, \"error\": " << r.error.json() << ", \"tolerance\": " << number(r.setting.tolerance)
-                 << ", \"stated_bound\": {\"max\": " << number(255.0 * r.bound.maxBound)
-                 << ", \"mean\": " << number(255.0 * r.bound.meanBound())
-                 << ", \"unbounded_pixels\": " << r.bound.unbounded << "}"
-                 << ", \"reference_ms\": " << number(referenceMs[r.scene])
-                 << ", \"cpu_default_ms\": " << number(cpuDefaultMs[r.scene])
-                 << ", \"failure\": " << jsonString(r.failure) << "}" << (i + 1 < results.size() ? "," : "") << "\n";
-        }
-        json << "  ],\n  \"peers\": [\n";
-        for (std::size_t i = 0; i < peers.size(); ++i) {
-            const Peer& p = peers[i];
-            json << "    {\"scene\": " << jsonString(p.scene) << ", \"size\": " << p.size
-                 << ", \"snell_dispatch_ms\": " << number(p.snellDispatchMs)
-                 << ", \"snell_command_ms\": " << number(p.snellCommandMs) << ", \"first_image_cold_ms\": "
-                 << number(p.coldMs) << ", \"first_image_warm_ms\": " << number(p.warmMs)
-                 << ", \"cpu_reference_ms\": " << number(p.cpuMs)
-                 << ", \"povray_trace_ms\": " << (p.povTraceMs ? number(*p.povTraceMs) : "null")
-                 << ", \"povray_command_ms\": " << (p.povCommandMs ? number(*p.povCommandMs) : "null")
-                 << ", \"note\": " << jsonString(p.povNote) << "}" << (i + 1 < peers.size() ? "," : "") << "\n";
-        }
-        json << "  ],\n  \"scaling\": [\n";
-        for (std::size_t i = 0; i < scaling.size(); ++i) {
-            const Scaling& s = scaling[i];
-            json << "    {\"spheres\": " << s.spheres << ", \"size\": " << s.size << ", \"parse_ms\": "
-                 << number(s.parseMs) << ", \"bvh_build_ms\": " << number(s.bvhBuildMs)
-                 << ", \"upload_ms\": " << number(s.uploadMs) << ", \"render_ms\": {\"median\": "
-                 << number(s.renderMs.median) << ", \"min\": " << number(s.renderMs.min) << ", \"max\": "
-                 << number(s.renderMs.max) << "}, \"gpu_scene_mib\": " << number(s.gpuMiB)
-                 << ", \"peak_rss_mib\": " << number(s.peakRssMiB) << "}" << (i + 1 < scaling.size() ? "," : "")
-                 << "\n";
-        }
-        json << "  ]\n}\n";
+}
+
+void writeResultJson(std::ostream& json, const Result& r, const Collected& c) {
+    json << "    {\"scene\": " << jsonString(r.scene) << ", \"setting\": " << jsonString(r.setting.name)
+         << ", \"precision\": \"" << (r.setting.precision == gpu::Precision::Fp64 ? "fp64" : "fp32")
+         << "\", \"bvh\": " << (r.bvhUsed ? "true" : "false") << ", \"depth\": " << r.setting.depth
+         << ", \"min_weight\": " << number(r.setting.minWeight) << ", \"supersample\": " << r.supersample
+         << ", \"spheres\": " << r.spheres << ", \"dispatch_ms\": {\"median\": " << number(r.dispatchMs.median)
+         << ", \"min\": " << number(r.dispatchMs.min) << ", \"max\": " << number(r.dispatchMs.max)
+         << "}, \"rays\": {\"primary\": " << r.rays.primary << ", \"shadow\": " << r.rays.shadow
+         << ", \"reflected\": " << r.rays.reflected << ", \"refracted\": " << r.rays.refracted
+         << "}, \"error\": " << r.error.json() << ", \"tolerance\": " << number(r.setting.tolerance)
+         << ", \"front\": " << (r.setting.front ? "true" : "false")
+         << ", \"stated_bound\": {\"max\": " << number(255.0 * r.bound.maxBound)
+         << ", \"mean\": " << number(255.0 * r.bound.meanBound()) << ", \"unbounded_pixels\": " << r.bound.unbounded
+         << ", \"estimated_pixels\": " << r.bound.estimated << ", \"over_tolerance_pixels\": "
+         << r.bound.overTolerance << ", \"over_budget_pixels\": " << r.bound.overBudget << "}"
+         << ", \"reference_ms\": " << number(c.referenceMs.at(r.scene))
+         << ", \"cpu_default_ms\": " << number(c.cpuDefaultMs.at(r.scene))
+         << ", \"failure\": " << jsonString(r.failure) << "}";
+}
+
+void writePriceJson(std::ostream& json, const Price& p) {
+    json << "    {\"scene\": " << jsonString(p.scene) << ", \"default_ms\": " << number(p.defaultMs)
+         << ", \"default_mean_abs_error\": " << number(p.defaultMean) << ", \"default_bad_pixels\": " << p.defaultBad
+         << ", \"price\": " << number(p.price) << ", \"price_is_upper_bound\": " << (p.upperBound ? "true" : "false")
+         << ", \"fixed_setting\": " << (p.fixed.empty() ? "null" : jsonString(p.fixed))
+         << ", \"fixed_ms\": " << number(p.fixedMs) << ", \"fixed_mean_abs_error\": " << number(p.fixedMean)
+         << ", \"fixed_bad_pixels\": " << p.fixedBad << ", \"fixed_tried\": " << p.tried
+         << ", \"pixels\": {\"total\": " << p.pixels << ", \"certified\": " << p.certified
+         << ", \"estimated\": " << p.estimated << ", \"unbounded_not_estimated\": " << p.unboundedNotEstimated
+         << ", \"over_tolerance\": " << p.overTolerance << ", \"over_budget\": " << p.overBudget << "}}";
+}
+
+void writePriceSummaryJson(std::ostream& json, const PriceSummary& s) {
+    json << "{\"geometric_mean\": " << number(s.geometricMean) << ", \"scenes\": " << s.scenes
+         << ", \"upper_bounds\": " << s.upperBounds
+         << ", \"worst_scene\": " << (s.worst ? jsonString(s.worst->scene) : "null")
+         << ", \"worst_price\": " << (s.worst ? number(s.worst->price) : "null")
+         << ", \"worst_is_upper_bound\": " << (s.worst && s.worst->upperBound ? "true" : "false")
+         << ", \"worst_fixed_setting\": " << (s.worst ? jsonString(s.worst->fixed) : "null") << "}";
+}
+
+// bench.json: everything, for tools.
+void writeJson(const fs::path& path, const Collected& c, const Ceiling& ceiling, vk::Context& context,
+               const std::string& device, int size, int runs) {
+    std::ofstream json(path);
+    json << "{\n  \"device\": " << jsonString(device) << ",\n  \"driver\": " << jsonString(context.driverInfo())
+         << ",\n  \"size\": " << size << ",\n  \"runs\": " << runs
+         << ",\n  \"timing\": \"" << (context.timestampsSupported() ? "gpu-timestamps" : "host") << "\""
+         << ",\n  \"ceiling_tests_per_s\": {\"centre_radius\": " << number(ceiling.centreRadius)
+         << ", \"inverse_matrix\": " << number(ceiling.matrix) << "},\n  \"floor\": {\"size\": "
+         << ceiling.floorSize << ", \"store_kernel_ms\": " << number(ceiling.storeMs)
+         << ", \"empty_scene_ms\": " << number(ceiling.emptySceneMs) << "},\n  \"results\": [\n";
+    for (std::size_t i = 0; i < c.results.size(); ++i) {
+        writeResultJson(json, c.results[i], c);
+        json << (i + 1 < c.results.size() ? "," : "") << "\n";
     }
+    json << "  ],\n  \"prices\": [\n";
+    for (std::size_t i = 0; i < c.prices.size(); ++i) {
+        writePriceJson(json, c.prices[i]);
+        json << (i + 1 < c.prices.size() ? "," : "") << "\n";
+    }
+    json << "  ],\n  \"price_summary\": ";
+    writePriceSummaryJson(json, summarizePrices(c.prices));
+    json << ",\n  \"peers\": [\n";
+    for (std::size_t i = 0; i < c.peers.size(); ++i) {
+        const Peer& p = c.peers[i];
+        json << "    {\"scene\": " << jsonString(p.scene) << ", \"size\": " << p.size
+             << ", \"snell_dispatch_ms\": " << number(p.snellDispatchMs)
+             << ", \"snell_command_ms\": " << number(p.snellCommandMs) << ", \"first_image_cold_ms\": "
+             << number(p.coldMs) << ", \"first_image_warm_ms\": " << number(p.warmMs)
+             << ", \"cpu_reference_ms\": " << number(p.cpuMs)
+             << ", \"povray_trace_ms\": " << (p.povTraceMs ? number(*p.povTraceMs) : "null")
+             << ", \"povray_command_ms\": " << (p.povCommandMs ? number(*p.povCommandMs) : "null")
+             << ", \"note\": " << jsonString(p.povNote) << "}" << (i + 1 < c.peers.size() ? "," : "") << "\n";
+    }
+    json << "  ],\n  \"scaling\": [\n";
+    for (std::size_t i = 0; i < c.scaling.size(); ++i) {
+        const Scaling& s = c.scaling[i];
+        json << "    {\"spheres\": " << s.spheres << ", \"size\": " << s.size << ", \"parse_ms\": "
+             << number(s.parseMs) << ", \"bvh_build_ms\": " << number(s.bvhBuildMs)
+             << ", \"upload_ms\": " << number(s.uploadMs) << ", \"render_ms\": {\"median\": "
+             << number(s.renderMs.median) << ", \"min\": " << number(s.renderMs.min) << ", \"max\": "
+             << number(s.renderMs.max) << "}, \"gpu_scene_mib\": " << number(s.gpuMiB)
+             << ", \"peak_rss_mib\": " << number(s.peakRssMiB) << "}" << (i + 1 < c.scaling.size() ? "," : "")
+             << "\n";
+    }
+    json << "  ]\n}\n";
+}
+
+}  // namespace
+
+void runBench(const BenchOptions& o, std::ostream& log) {
+    const int size = o.size > 0 ? o.size : (o.quick ? 32 : 128);
+    const int runs = std::max(5, o.runs);
+    fs::create_directories(o.outDir);
+    const std::vector<SceneFile> files = collectScenes(o);
+    if (files.empty()) throw BenchError("no scenes to benchmark");
+
+    vk::ContextOptions contextOptions;
+    contextOptions.deviceIndex = o.gpu;
+    vk::Context context(contextOptions);
+    const std::string device = context.deviceName() + " (" + context.driverInfo() + ")";
+    log << "bench: " << files.size() << " scenes at " << size << "x" << size << ", " << runs
+        << " timed runs per setting, on " << device
+        << (context.timestampsSupported() ? "" : "; no GPU timestamps: host timing") << "\n";
+
+    const auto ceilingStart = Clock::now();
+    const Ceiling ceiling = measureCeiling(context, runs, o.quick);
+    log << "ceiling: " << ceiling.centreRadius * 1e-9 << " G ray-sphere tests/s (centre+radius), "
+        << ceiling.matrix * 1e-9 << " G (inverse matrix); floor at " << ceiling.floorSize << "²: store-only kernel "
+        << number(ceiling.storeMs) << " ms, empty scene " << number(ceiling.emptySceneMs) << " ms; "
+        << msSince(ceilingStart) / 1000 << " s\n";
+
+    Collected collected;
+    for (const SceneFile& file : files) {
+        if (o.cancel && o.cancel->load()) throw BenchError("cancelled");
+        benchScene(context, o, file, size, runs, collected, log);
+    }
+    collected.scaling = measureScaling(context, o, runs, log);
+
+    writeCsv(fs::path(o.outDir) / "bench.csv", collected, ceiling);
+    writeJson(fs::path(o.outDir) / "bench.json", collected, ceiling, context, device, size, runs);
+    log << describe(summarizePrices(collected.prices)) << "\n";
     log << "bench: wrote " << (fs::path(o.outDir) / "bench.csv").string()
         << " and bench.json; bench/summarize.py makes the tables and the plot\n";
 }

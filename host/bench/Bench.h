@@ -5,8 +5,13 @@
 // and records the peers of the same run: the CPU reference itself (converged,
 // and at the GPU's default settings), POV-Ray 3.7 on the shared bench scenes,
 // the device's ray–sphere ceiling and store-only floor, and the render time
-// against sphere count. Writes bench.csv and bench.json; bench/summarize.py
-// turns them into tables and a plot.
+// against sphere count. It prices the default settings per scene: their
+// dispatch time over that of the fastest fixed tree (tolerance 0: a weight
+// cut-off 4^-k, or a depth cap without one) whose measured error is no worse,
+// swept in order of growing cost and stopped where no later tree could set
+// the price (an upper bound where none tried is as accurate); the geometric
+// mean and the worst scene close the log. Writes bench.csv and bench.json;
+// bench/summarize.py turns them into tables and a plot.
 #pragma once
 
 #include <atomic>

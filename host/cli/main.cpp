@@ -714,8 +714,8 @@ int main(int argc, char** argv) {
     bo.cancel = &gInterrupted;
     CLI::App* bench = app.add_subcommand("bench", "Speed against error: sweep settings, compare with peers, write CSV and JSON (bench/summarize.py: tables, plot)");
     bench->add_option("scenes", bo.scenes, "Scene files or directories (default: scenes/, scenes/hard/, the course and bench scenes)");
-    bench->add_flag("--quick", bo.quick, "A small, fast run (CI): scenes/ and the bench scenes at 48x48, fewer settings");
-    bench->add_option("-s,--size", bo.size, "Image size (default 128; quick 48)")->check(CLI::Range(8, 4096));
+    bench->add_flag("--quick", bo.quick, "A small, fast run (CI): scenes/ and the bench scenes at 32x32, fewer settings");
+    bench->add_option("-s,--size", bo.size, "Image size (default 128; quick 32)")->check(CLI::Range(8, 4096));
     bench->add_option("--runs", bo.runs, "Timed runs per setting after a warm-up (at least 5)")->check(CLI::Range(5, 1000));
     bench->add_option("-o,--out", bo.outDir, "Directory for bench.csv and bench.json (default bench/results)");
     bench->add_option("--source-dir", bo.sourceDir, "The snell repository (default: . if it has scenes/, else the build's)");
