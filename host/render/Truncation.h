@@ -30,8 +30,8 @@ struct RadianceBound {
 };
 RadianceBound radianceBound(const Scene& scene);
 
-// What is known of one pixel's exact colour after one or more attempts at
-// its ray tree (each with its own cut-off): every attempt's colour is a lower
+// What is known of one pixel's exact colour after one or more steps of its
+// ray tree (each with its own cut-off): every step's colour is a lower
 // bound, as every term of the sum is >= 0, and its colour plus the light it
 // dropped (dropped weight times R) an upper bound. The pixel keeps the largest
 // lower and the smallest upper bound of each channel, clamped to [0, 1] where
@@ -40,7 +40,7 @@ struct PixelEstimate {
     glm::dvec3 lower{0.0};  // the colour reported (unclamped)
     glm::dvec3 upper{std::numeric_limits<double>::infinity()};
 
-    // One attempt: `sum` its colour and `dropped` the weight of the rays it
+    // One step: `sum` its colour and `dropped` the weight of the rays it
     // did not trace, both summed over `samples`.
     void add(const RadianceBound& radiance, const glm::dvec3& sum, const glm::dvec3& dropped, double samples);
     // On the clamped colour; a channel whose upper bound is infinite is
