@@ -297,10 +297,9 @@ void CpuRenderer::trace(const PendingRay& root, dvec3& pixelSum, double saturati
         for (int c = 0; c < 3; ++c)
             if (reflectedGain[c] + transmittedGain[c] > 1.0 && r.weight[c] > 0.0) tree.amplified = true;
         dvec3 reflectedWeight = childWeight(r.weight, reflectedGain);
-        dvec3 transmittedWeight(0.0);
         std::optional<PendingRay> refractedRay;
         if (settings.refraction && m.refracts()) {
-            transmittedWeight = childWeight(r.weight, transmittedGain);
+            const dvec3 transmittedWeight = childWeight(r.weight, transmittedGain);
             MediumStack media = r.media;
             double etaI, etaT;
             if (fromOutside) {
@@ -318,14 +317,16 @@ void CpuRenderer::trace(const PendingRay& root, dvec3& pixelSum, double saturati
                 // medium: one ray carrying both weights (exactly SPEC §4.5).
                 reflectedWeight = glm::min(reflectedWeight + transmittedWeight, dvec3(kMaxWeight));
             } else {
-                refractedRay = PendingRay{{x, refracted}, transmittedWeight, r.depth + 1, hit.sphere,
-                                          fromOutside, true, media};
-                if (!worthTracing(transmittedWeight)) defer(*std::move(refractedRay)), refractedRay.reset();
+                PendingRay child{{x, refracted}, transmittedWeight, r.depth + 1, hit.sphere, fromOutside, true, media};
+                if (worthTracing(transmittedWeight)) refractedRay = std::move(child);
+                else defer(std::move(child));
             }
         }
-        std::optional<PendingRay> reflectedRay =
-            PendingRay{{x, reflectDirection(d, n)}, reflectedWeight, r.depth + 1, hit.sphere, !fromOutside, false, r.media};
-        if (!worthTracing(reflectedWeight)) defer(*std::move(reflectedRay)), reflectedRay.reset();
+        std::optional<PendingRay> reflectedRay;
+        PendingRay reflectedChild{{x, reflectDirection(d, n)}, reflectedWeight, r.depth + 1, hit.sphere, !fromOutside,
+                                  false, r.media};
+        if (worthTracing(reflectedWeight)) reflectedRay = std::move(reflectedChild);
+        else defer(std::move(reflectedChild));
         // The lighter child is traced next and the heavier waits (as the
         // shader does, whose stack this bounds: ComputeRenderer.cpp); in an
         // amplifying scene the heavier goes first, so that a tree budget is
