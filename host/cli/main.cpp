@@ -632,7 +632,8 @@ std::string versionText() {
 
 int main(int argc, char** argv) {
     CLI::App app{"snell: a Whitted-style ray tracer whose renderer is a Vulkan compute shader.\n"
-                 "Scene format: see README.md and SPEC.md."};
+                 "Scene format: see README.md and SPEC.md.",
+                 "snell"};
     app.footer(kExitStatuses);
     app.require_subcommand(0, 1);
     bool version = false;
