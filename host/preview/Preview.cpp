@@ -190,7 +190,9 @@ void Session::reload() {
         error_.clear();
     } catch (const ParseError& e) {
         std::cerr << e.what() << "\n";
-        error_ = e.what();
+        // The title has room for one line: the first error (SPEC §7).
+        const bool more = e.diagnostics().size() > 1 || e.notShown() > 0;
+        error_ = e.diagnostic().format("error") + (more ? " (more on standard error)" : "");
         reloadStart_.reset();
     }
     updateTitle();

@@ -15,6 +15,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "common/EditDistance.h"
 #include "scene/Transform.h"
 
 namespace snell {
@@ -25,47 +26,60 @@ struct Token {
     int column = 1;
 };
 
+enum class Op { View, Sphere, Scale, Move, Rotate, Light, Background, Ambient, Group, GroupEnd,
+                Material, Refraction, Supersample };
+
 struct CommandSpec {
     std::string_view name;
+    Op op;
     int arity;
     std::string_view usage;
 };
 
 constexpr std::array<CommandSpec, 13> kCommands{{
-    {"view", 2, "view n d"},
-    {"sphere", 0, "sphere"},
-    {"scale", 3, "scale sx sy sz"},
-    {"move", 3, "move x y z"},
-    {"rotate", 4, "rotate angle x y z"},
-    {"light", 6, "light r g b x y z"},
-    {"background", 3, "background r g b"},
-    {"ambient", 3, "ambient r g b"},
-    {"group", 0, "group"},
-    {"groupend", 0, "groupend"},
-    {"material", 7, "material dr dg db sr sg sb p"},
-    {"refraction", 4, "refraction r g b i"},
-    {"supersample", 1, "supersample s"},
+    {"view", Op::View, 2, "view n d"},
+    {"sphere", Op::Sphere, 0, "sphere"},
+    {"scale", Op::Scale, 3, "scale sx sy sz"},
+    {"move", Op::Move, 3, "move x y z"},
+    {"rotate", Op::Rotate, 4, "rotate angle x y z"},
+    {"light", Op::Light, 6, "light r g b x y z"},
+    {"background", Op::Background, 3, "background r g b"},
+    {"ambient", Op::Ambient, 3, "ambient r g b"},
+    {"group", Op::Group, 0, "group"},
+    {"groupend", Op::GroupEnd, 0, "groupend"},
+    {"material", Op::Material, 7, "material dr dg db sr sg sb p"},
+    {"refraction", Op::Refraction, 4, "refraction r g b i"},
+    {"supersample", Op::Supersample, 1, "supersample s"},
 }};
-
-int editDistance(std::string_view a, std::string_view b) {
-    std::vector<int> row(b.size() + 1);
-    for (std::size_t j = 0; j <= b.size(); ++j) row[j] = static_cast<int>(j);
-    for (std::size_t i = 1; i <= a.size(); ++i) {
-        int diagonal = row[0];
-        row[0] = static_cast<int>(i);
-        for (std::size_t j = 1; j <= b.size(); ++j) {
-            const int above = row[j];
-            row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] != b[j - 1])});
-            diagonal = above;
-        }
-    }
-    return row[b.size()];
-}
 
 std::string lower(std::string_view s) {
     std::string out(s);
     for (char& c : out) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
     return out;
+}
+
+const CommandSpec* findCommand(std::string_view name) {
+    for (const CommandSpec& c : kCommands)
+        if (c.name == name) return &c;
+    return nullptr;
+}
+
+// The command a misspelt name most likely means (case aside, at most two
+// edits away), or empty.
+std::string_view closestCommand(std::string_view name) {
+    const std::string lowered = lower(name);
+    std::string_view best;
+    std::size_t bestDistance = 3;
+    for (const CommandSpec& c : kCommands) {
+        // The length difference bounds the distance: a long token costs no
+        // quadratic work.
+        const std::size_t lengthGap = std::max(lowered.size(), c.name.size()) -
+                                      std::min(lowered.size(), c.name.size());
+        if (lengthGap >= bestDistance) continue;
+        const auto d = static_cast<std::size_t>(editDistance(lowered, c.name));
+        if (d < bestDistance) { bestDistance = d; best = c.name; }
+    }
+    return best;
 }
 
 // A token printed in a message: long or binary tokens are shortened/escaped.
@@ -109,6 +123,42 @@ std::size_t utf8SequenceLength(std::string_view s, std::size_t i) {
     return n;
 }
 
+// Thrown to abandon the rest of a line at its first error.
+struct LineError {
+    Diagnostic diagnostic;
+};
+
+// A scene's errors in the order found: the first kMaxReportedErrors kept,
+// every one counted.
+class ErrorList {
+public:
+    void add(Diagnostic d) {
+        if (listed_.size() < ParseLimits::kMaxReportedErrors) listed_.push_back(std::move(d));
+        ++count_;
+    }
+    bool empty() const { return count_ == 0; }
+    bool full() const { return count_ >= ParseLimits::kMaxCountedErrors; }
+    std::optional<ParseError> take(int stoppedAtLine) {
+        if (count_ == 0) return std::nullopt;
+        const std::size_t notShown = count_ - listed_.size();
+        return ParseError(std::move(listed_), notShown, stoppedAtLine);
+    }
+
+private:
+    std::vector<Diagnostic> listed_;
+    std::size_t count_ = 0;
+};
+
+// The first word of a raw line (up to a space, tab or '#'), bad bytes and all:
+// what a line that failed was meant to do.
+Token commandWord(std::string_view line) {
+    std::size_t i = 0;
+    while (i < line.size() && (line[i] == ' ' || line[i] == '\t')) ++i;
+    std::size_t j = i;
+    while (j < line.size() && line[j] != ' ' && line[j] != '\t' && line[j] != '#') ++j;
+    return {line.substr(i, j - i), static_cast<int>(i) + 1};
+}
+
 class Parser {
 public:
     Parser(std::string_view text, std::string fileName) : text_(text), file_(std::move(fileName)) {
@@ -116,9 +166,19 @@ public:
         scene_.name = p.stem().string();
     }
 
-    Scene run() {
-        // Reserve for the spheres and materials the text can name at most, so
-        // a million-sphere file is not copied as the vectors grow.
+    ParseOutcome run() {
+        reserveForText();
+        const int stoppedAtLine = scanLines();
+        if (stoppedAtLine == 0) checkEndOfFile();
+        // Warnings are about a scene that will be rendered: one without errors.
+        if (errors_.empty()) addWarnings();
+        return {std::move(scene_), errors_.take(stoppedAtLine)};
+    }
+
+private:
+    // Reserve for the spheres and materials the text can name at most, so a
+    // million-sphere file is not copied as the vectors grow.
+    void reserveForText() {
         auto occurrences = [this](std::string_view word) {
             std::size_t count = 0;
             for (std::size_t at = text_.find(word); at != std::string_view::npos; at = text_.find(word, at + 1))
@@ -128,54 +188,76 @@ public:
         const std::size_t sphereCount = std::min(occurrences("sphere"), ParseLimits::kMaxSpheres);
         scene_.spheres.reserve(sphereCount);
         materialIndex_.reserve(std::min(sphereCount, occurrences("material") + occurrences("refraction")) + 1);
+    }
+
+    // Every line, in order. Returns 0, or the line after which reading stopped
+    // because kMaxCountedErrors were found.
+    int scanLines() {
         std::size_t pos = 0;
-        int lineNumber = 1;
-        while (pos < text_.size()) {
+        for (int lineNumber = 1; pos < text_.size(); ++lineNumber) {
             std::size_t end = pos;
             while (end < text_.size() && text_[end] != '\n') ++end;
             std::string_view line = text_.substr(pos, end - pos);
             // CRLF; a CR not followed by LF (even at the end of the file) is an error.
             if (end < text_.size() && !line.empty() && line.back() == '\r') line.remove_suffix(1);
-            parseLine(line, lineNumber);
+            parseLineRecovering(line, lineNumber);
+            if (errors_.full()) return lineNumber;
             pos = end + 1;
-            ++lineNumber;
         }
-        if (!viewLocation_) fail(1, 1, "missing 'view' command: a scene needs exactly one 'view n d'");
-        for (const SourceLocation& open : groupStack_locations_)
-            scene_.warnings.push_back({open, "'group' is never closed by a 'groupend'"});
-        for (std::size_t m = 0; m < scene_.materials.size(); ++m) {
-            if (scene_.materials[m].amplifies()) {
-                scene_.warnings.push_back(
-                    {amplifyingLocation_[m],
-                     "material has ks + kt > 1 in some channel: its ray tree can gain weight "
-                     "with depth (SPEC §4); float output in diverging channels is a partial sum"});
-            }
-        }
-        return std::move(scene_);
+        return 0;
     }
 
-private:
-    [[noreturn]] void fail(int line, int column, std::string message) const {
-        throw ParseError(Diagnostic{{file_, line, column}, std::move(message)});
-    }
-    [[noreturn]] void fail(const Token& t, std::string message) const {
-        fail(line_, t.column, std::move(message));
-    }
-
-    void parseLine(std::string_view line, int lineNumber) {
+    // An error abandons the rest of its line (one error per line, so the
+    // errors come in SPEC §7 file order); the next line is parsed as usual.
+    void parseLineRecovering(std::string_view line, int lineNumber) {
         line_ = lineNumber;
-        // Bytes first: NUL, stray CR and invalid UTF-8 anywhere on the line
-        // (comments included) are errors, reported at the offending byte.
-        for (std::size_t i = 0; i < line.size();) {
-            const char c = line[i];
-            if (c == '\0') fail(lineNumber, static_cast<int>(i) + 1, "NUL byte in scene file");
-            if (c == '\r')
-                fail(lineNumber, static_cast<int>(i) + 1,
-                     "carriage return not followed by a line feed");
-            const std::size_t n = utf8SequenceLength(line, i);
-            if (n == 0) fail(lineNumber, static_cast<int>(i) + 1, "invalid UTF-8 byte sequence");
-            i += n;
+        try {
+            parseLine(line);
+        } catch (LineError& e) {
+            errors_.add(std::move(e.diagnostic));
+            recoverFrom(commandWord(line));
         }
+    }
+
+    // A failed line changes no state, except what keeps one mistake from
+    // being reported again by a later line: a group or groupend still opens or
+    // closes its level (else its partner would be unmatched), and a view still
+    // counts (else "missing 'view'" would follow). A misspelt command counts as
+    // the one its hint names.
+    void recoverFrom(const Token& word) {
+        const std::string_view command = findCommand(word.text) ? word.text : closestCommand(word.text);
+        if (command == "group") {
+            openGroup(word.column);
+        } else if (command == "groupend") {
+            closeGroup();
+        } else if (command == "view") {
+            viewTried_ = true;
+            if (word.text == "view" && viewLine_ == 0) viewLine_ = line_;
+        }
+    }
+
+    // SPEC §2, §7: a missing view is an error at 1:1, found (and listed) last.
+    void checkEndOfFile() {
+        if (viewLine_ != 0 || viewTried_) return;
+        Diagnostic missing;
+        missing.location.file = file_;  // at 1:1
+        missing.message = "missing 'view' command: a scene needs exactly one 'view n d'";
+        errors_.add(std::move(missing));
+    }
+
+    void addWarnings() {
+        for (const SourceLocation& open : groupStack_locations_)
+            scene_.warnings.push_back({open, "'group' is never closed by a 'groupend'; add one where the group should end (its "
+                                       "transform and material apply to the end of the file)"});
+    }
+
+    [[noreturn]] void fail(int column, std::string message) const {
+        throw LineError{Diagnostic{{file_, line_, column}, std::move(message)}};
+    }
+    [[noreturn]] void fail(const Token& t, std::string message) const { fail(t.column, std::move(message)); }
+
+    void parseLine(std::string_view line) {
+        checkBytes(line);
         // SPEC §1: '#' starts a comment wherever it stands.
         if (const std::size_t hash = line.find('#'); hash != std::string_view::npos)
             line = line.substr(0, hash);
@@ -190,64 +272,104 @@ private:
         if (!tokens_.empty()) command();
     }
 
-    const CommandSpec& lookUp(const Token& name) const {
-        for (const CommandSpec& c : kCommands)
-            if (c.name == name.text) return c;
-        std::string message = "unknown command " + quoted(name.text);
-        const std::string lowered = lower(name.text);
-        std::string_view best;
-        int bestDistance = 3;
-        for (const CommandSpec& c : kCommands) {
-            const int d = lowered == c.name ? 0 : editDistance(lowered, c.name);
-            if (d < bestDistance) { bestDistance = d; best = c.name; }
+    // Bytes first: NUL, stray CR and invalid UTF-8 anywhere on the line
+    // (comments included) are errors, reported at the offending byte.
+    void checkBytes(std::string_view line) const {
+        for (std::size_t i = 0; i < line.size();) {
+            const char c = line[i];
+            const int column = static_cast<int>(i) + 1;
+            if (c == '\0') fail(column, "NUL byte in scene file");
+            if (c == '\r') fail(column, "carriage return not followed by a line feed");
+            const std::size_t n = utf8SequenceLength(line, i);
+            if (n == 0) fail(column, "invalid UTF-8 byte sequence");
+            i += n;
         }
-        if (!best.empty()) message += "; did you mean '" + std::string(best) + "'?";
-        else message += " (commands: view, sphere, scale, move, rotate, light, background, "
-                        "ambient, group, groupend, material, refraction, supersample)";
+    }
+
+    const CommandSpec& lookUp(const Token& name) const {
+        if (const CommandSpec* c = findCommand(name.text)) return *c;
+        std::string message = "unknown command " + quoted(name.text);
+        if (const std::string_view best = closestCommand(name.text); !best.empty())
+            message += "; did you mean '" + std::string(best) + "'?";
+        else
+            message += " (commands: view, sphere, scale, move, rotate, light, background, "
+                       "ambient, group, groupend, material, refraction, supersample)";
         fail(name, message);
     }
 
+    // SPEC §7 file order on a line: the command token's errors, then the
+    // arguments left to right, then extra arguments. Each command checks all
+    // of them before it takes effect, so a failed line changes nothing.
     void command() {
         const Token& name = tokens_[0];
-        const CommandSpec& spec = lookUp(name);
+        spec_ = &lookUp(name);
+        if (static_cast<int>(tokens_.size()) - 1 < spec_->arity) tooFewArguments();
+        checkCommandToken(name);
+        perform();
+    }
+
+    [[noreturn]] void tooFewArguments() const {
         const int given = static_cast<int>(tokens_.size()) - 1;
-        if (given < spec.arity)
-            fail(name, "'" + std::string(spec.name) + "' expects " + std::to_string(spec.arity) +
-                           " argument" + (spec.arity == 1 ? "" : "s") + " (" +
-                           std::string(spec.usage) + "), got " + std::to_string(given));
-        // Errors that belong to the command token come first, then the
-        // arguments left to right, then extra arguments (SPEC §7 file order).
-        const std::string_view n = spec.name;
-        if (n == "view" && viewLocation_)
-            fail(name, "second 'view' command (the first is at line " + std::to_string(viewLocation_->line) +
+        fail(tokens_[0], "'" + std::string(spec_->name) + "' expects " + std::to_string(spec_->arity) +
+                             " argument" + (spec_->arity == 1 ? "" : "s") + " (" + std::string(spec_->usage) +
+                             "), got " + std::to_string(given));
+    }
+
+    // The errors that stand at the command token itself.
+    void checkCommandToken(const Token& name) {
+        const Op op = spec_->op;
+        if (op == Op::View && viewLine_ != 0)
+            fail(name, "second 'view' command (the first is at line " + std::to_string(viewLine_) +
                            "); a scene has exactly one");
-        if (n == "groupend" && groupStack_.empty()) fail(name, "'groupend' without a matching 'group'");
-        if (n == "group" && groupStack_.size() >= static_cast<std::size_t>(ParseLimits::kMaxGroupDepth))
+        if (op == Op::GroupEnd && groupStack_.empty()) fail(name, "'groupend' without a matching 'group'");
+        // Once past the depth limit, deeper groups are the same mistake.
+        if (op == Op::Group && groupStack_.size() >= static_cast<std::size_t>(ParseLimits::kMaxGroupDepth) &&
+            levelsBeyondLimit_ == 0)
             fail(name, "groups nested deeper than snell's limit of " +
                            std::to_string(ParseLimits::kMaxGroupDepth) + " levels");
-        if (n == "sphere" && scene_.spheres.size() >= ParseLimits::kMaxSpheres)
-            fail(name, "too many spheres: snell's limit is " + std::to_string(ParseLimits::kMaxSpheres));
-        if (n == "sphere" && !state_.transform.invertible())
-            fail(name, "the current transform is degenerate (not invertible in double precision)");
-        if (n == "light" && scene_.lights.size() >= ParseLimits::kMaxLights)
+        if (op == Op::Sphere) checkSphereToken(name);
+        if (op == Op::Light && scene_.lights.size() >= ParseLimits::kMaxLights && !lightLimitReported_) {
+            lightLimitReported_ = true;  // the later lights are the same mistake
             fail(name, "too many lights: snell's limit is " + std::to_string(ParseLimits::kMaxLights));
-        if (n == "view") view();
-        else if (n == "sphere") sphere();
-        else if (n == "scale") scale();
-        else if (n == "move") move();
-        else if (n == "rotate") rotate();
-        else if (n == "light") light();
-        else if (n == "background") scene_.background = colour(1, "background");
-        else if (n == "ambient") scene_.ambient = colour(1, "ambient");
-        else if (n == "group") group();
-        else if (n == "groupend") groupEnd();
-        else if (n == "material") material();
-        else if (n == "refraction") refraction();
-        else if (n == "supersample") supersample();
-        if (given > spec.arity)
-            fail(tokens_[spec.arity + 1], "too many arguments to '" + std::string(spec.name) +
-                                              "': expected " + std::to_string(spec.arity) +
-                                              " (" + std::string(spec.usage) + ")");
+        }
+    }
+
+    void checkSphereToken(const Token& name) {
+        if (scene_.spheres.size() >= ParseLimits::kMaxSpheres && !sphereLimitReported_) {
+            sphereLimitReported_ = true;  // the later spheres are the same mistake
+            fail(name, "too many spheres: snell's limit is " + std::to_string(ParseLimits::kMaxSpheres));
+        }
+        if (!state_.transform.invertible())
+            fail(name, "the current transform is degenerate (not invertible in double precision)");
+    }
+
+    void perform() {
+        switch (spec_->op) {
+            case Op::View: return view();
+            case Op::Sphere: return sphere();
+            case Op::Scale: return scale();
+            case Op::Move: return move();
+            case Op::Rotate: return rotate();
+            case Op::Light: return light();
+            case Op::Background: scene_.background = colourCommand("background"); return;
+            case Op::Ambient: scene_.ambient = colourCommand("ambient"); return;
+            case Op::Group: return group();
+            case Op::GroupEnd: return groupEnd();
+            case Op::Material: return material();
+            case Op::Refraction: return refraction();
+            case Op::Supersample: return supersample();
+        }
+    }
+
+    // Called by each command after its arguments' own checks, before it takes effect.
+    void endOfArguments() const {
+        if (static_cast<int>(tokens_.size()) - 1 > spec_->arity) tooManyArguments();
+    }
+
+    [[noreturn]] void tooManyArguments() const {
+        const int arity = spec_->arity;
+        fail(tokens_[arity + 1], "too many arguments to '" + std::string(spec_->name) + "': expected " +
+                                     std::to_string(arity) + " (" + std::string(spec_->usage) + ")");
     }
 
     // SPEC §1 number: decimal, optional sign and exponent; finite.
@@ -331,18 +453,32 @@ private:
         return c;
     }
 
+    dvec3 colourCommand(const char* what) {
+        const dvec3 c = colour(1, what);
+        endOfArguments();
+        return c;
+    }
+
+    dvec3 vector(int first) {
+        dvec3 v;
+        for (int k = 0; k < 3; ++k) v[k] = number(first + k);
+        return v;
+    }
+
     void view() {
         const long long n = integer(1, "view: image size n", 1, ParseLimits::kMaxImageSize);
         const double d = number(2);
         if (!(d > 0.0)) fail(tokens_[2], "view: half-width d must be > 0, got " + quoted(tokens_[2].text));
-        viewLocation_ = here(tokens_[0]);
+        endOfArguments();
+        viewLine_ = line_;
         scene_.imageSize = static_cast<int>(n);
         scene_.halfWidth = d;
     }
 
     void supersample() {
-        scene_.supersample = static_cast<int>(
-            integer(1, "supersample: s", 1, ParseLimits::kMaxSupersample));
+        const long long s = integer(1, "supersample: s", 1, ParseLimits::kMaxSupersample);
+        endOfArguments();
+        scene_.supersample = static_cast<int>(s);
     }
 
     void scale() {
@@ -351,72 +487,102 @@ private:
             s[k] = number(1 + k);
             if (s[k] == 0.0) fail(tokens_[1 + k], "scale factor must not be zero (the sphere would be degenerate)");
         }
+        endOfArguments();
         state_.transform.scale(s);
     }
 
     void move() {
-        dvec3 v;
-        for (int k = 0; k < 3; ++k) v[k] = number(1 + k);
+        const dvec3 v = vector(1);
+        endOfArguments();
         state_.transform.translate(v);
     }
 
     void rotate() {
         const double degrees = number(1);
-        dvec3 axis;
-        for (int k = 0; k < 3; ++k) axis[k] = number(2 + k);
+        const dvec3 axis = vector(2);
         if (axis == dvec3(0.0)) fail(tokens_[2], "rotation axis (0 0 0) has zero length");
+        endOfArguments();
         state_.transform.rotate(degrees, axis);
     }
 
     void light() {
         Light l;
         l.colour = colour(1, "light colour");
-        for (int k = 0; k < 3; ++k) l.position[k] = number(4 + k);
-        scene_.lights.push_back(l);
+        l.position = vector(4);
+        endOfArguments();
+        // Past the limit (reported once) the light is dropped.
+        if (scene_.lights.size() < ParseLimits::kMaxLights) scene_.lights.push_back(l);
     }
 
     void material() {
-        state_.material.kd = colour(1, "material: diffuse kd");
-        state_.material.ks = colour(4, "material: specular ks");
-        state_.material.phong = nonNegative(7, "material: Phong exponent p");
+        const dvec3 kd = colour(1, "material: diffuse kd");
+        const dvec3 ks = colour(4, "material: specular ks");
+        const double phong = nonNegative(7, "material: Phong exponent p");
+        endOfArguments();
+        state_.material.kd = kd;
+        state_.material.ks = ks;
+        state_.material.phong = phong;
     }
 
     void refraction() {
-        state_.material.kt = colour(1, "refraction: transmission kt");
+        const dvec3 kt = colour(1, "refraction: transmission kt");
         const double eta = number(4);
         if (!(eta > 0.0)) fail(tokens_[4], "refraction: index of refraction must be > 0, got " + quoted(tokens_[4].text));
+        endOfArguments();
+        state_.material.kt = kt;
         state_.material.eta = eta;
     }
 
     void group() {
-        groupStack_.push_back(state_);
-        groupStack_locations_.push_back(here(tokens_[0]));
+        endOfArguments();
+        openGroup(tokens_[0].column);
     }
 
     void groupEnd() {
-        state_ = groupStack_.back();
-        groupStack_.pop_back();
-        groupStack_locations_.pop_back();
+        endOfArguments();
+        closeGroup();
+    }
+
+    // Past the depth limit (reported once) a group only counts its level, and
+    // closing the outermost such level restores the state at its group.
+    void openGroup(int column) {
+        if (groupStack_.size() < static_cast<std::size_t>(ParseLimits::kMaxGroupDepth)) {
+            groupStack_.push_back(state_);
+            groupStack_locations_.push_back({file_, line_, column});
+        } else if (levelsBeyondLimit_++ == 0) {
+            stateBeyondLimit_ = state_;
+        }
+    }
+
+    // Does nothing without an open group: that is a failed groupend's recovery.
+    void closeGroup() {
+        if (levelsBeyondLimit_ > 0) {
+            if (--levelsBeyondLimit_ == 0) state_ = stateBeyondLimit_;
+        } else if (!groupStack_.empty()) {
+            state_ = groupStack_.back();
+            groupStack_.pop_back();
+            groupStack_locations_.pop_back();
+        }
     }
 
     void sphere() {
+        endOfArguments();
+        // Past the limit (reported once) the sphere is dropped.
+        if (scene_.spheres.size() >= ParseLimits::kMaxSpheres) return;
         Sphere s;
         s.worldFromObject = state_.transform.worldFromObject();
         s.objectFromWorld = state_.transform.objectFromWorld();
         s.location = {line_, tokens_[0].column};
-        s.material = internMaterial(state_.material, here(tokens_[0]));
+        s.material = internMaterial(state_.material);
         classifySphere(s);
         scene_.spheres.push_back(std::move(s));
     }
 
-    std::uint32_t internMaterial(const Material& m, const SourceLocation& where) {
+    std::uint32_t internMaterial(const Material& m) {
         // Most scenes reuse a handful of materials: deduplicate them.
         if (!scene_.materials.empty() && scene_.materials[lastMaterial_] == m) return lastMaterial_;
         const auto [it, inserted] = materialIndex_.try_emplace(m, static_cast<std::uint32_t>(scene_.materials.size()));
-        if (inserted) {
-            scene_.materials.push_back(m);
-            amplifyingLocation_.push_back(where);
-        }
+        if (inserted) scene_.materials.push_back(m);
         return lastMaterial_ = it->second;
     }
 
@@ -431,27 +597,63 @@ private:
     std::string file_;
     int line_ = 1;
     std::vector<Token> tokens_;
+    const CommandSpec* spec_ = nullptr;  // the current line's command
     Scene scene_;
     State state_;
     std::vector<State> groupStack_;
     std::vector<SourceLocation> groupStack_locations_;
-    std::optional<SourceLocation> viewLocation_;
-    std::vector<SourceLocation> amplifyingLocation_;
+    int levelsBeyondLimit_ = 0;  // open groups past kMaxGroupDepth
+    State stateBeyondLimit_;
+    int viewLine_ = 0;        // the first line whose command is 'view', 0 if none
+    bool viewTried_ = false;  // a failed line meant a 'view' (recoverFrom)
+    bool sphereLimitReported_ = false;
+    bool lightLimitReported_ = false;
+    ErrorList errors_;
     std::uint32_t lastMaterial_ = 0;
     std::unordered_map<Material, std::uint32_t, MaterialHash> materialIndex_;
 };
 
+std::string errorReport(const std::vector<Diagnostic>& listed, std::size_t notShown, int stoppedAtLine) {
+    std::string out;
+    for (const Diagnostic& d : listed) {
+        if (!out.empty()) out += '\n';
+        out += d.format("error");
+    }
+    if (notShown == 0) return out;
+    out += '\n' + listed.front().location.file + ": error: " + (stoppedAtLine > 0 ? "at least " : "") +
+           std::to_string(notShown) + " more error" + (notShown == 1 ? "" : "s") + " not shown";
+    if (stoppedAtLine > 0)
+        out += " (stopped reading at line " + std::to_string(stoppedAtLine) + " after " +
+               std::to_string(ParseLimits::kMaxCountedErrors) + " errors)";
+    return out;
+}
+
 }  // namespace
 
-Scene parseScene(std::string_view text, const std::string& fileName) {
+ParseError::ParseError(Diagnostic d) : ParseError(std::vector<Diagnostic>{std::move(d)}, 0, 0) {}
+
+ParseError::ParseError(std::vector<Diagnostic> listed, std::size_t notShown, int stoppedAtLine)
+    : std::runtime_error(errorReport(listed, notShown, stoppedAtLine)),
+      diagnostics_(std::move(listed)),
+      notShown_(notShown),
+      stoppedAtLine_(stoppedAtLine) {}
+
+ParseOutcome parseSceneRecovering(std::string_view text, const std::string& fileName) {
     return Parser(text, fileName).run();
 }
 
+Scene parseScene(std::string_view text, const std::string& fileName) {
+    ParseOutcome outcome = parseSceneRecovering(text, fileName);
+    if (outcome.error) throw std::move(*outcome.error);
+    return std::move(outcome.scene);
+}
+
 Scene parseSceneFile(const std::string& path) {
-    // File-level failures are reported at 1:1 of the file (SPEC §7 format).
+    // A file that cannot be read has no position to report: "FILE: error: ...".
     auto fileError = [&path](const std::string& message) {
         Diagnostic d;
         d.location.file = path;
+        d.location.line = d.location.column = 0;
         d.message = message;
         return ParseError(std::move(d));
     };

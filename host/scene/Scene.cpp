@@ -5,6 +5,8 @@
 namespace snell {
 
 std::string Diagnostic::format(const char* severity) const {
+    // A problem of the whole file (it cannot be opened) has no position.
+    if (location.line <= 0) return location.file + ": " + severity + ": " + message;
     return location.file + ":" + std::to_string(location.line) + ":" +
            std::to_string(location.column) + ": " + severity + ": " + message;
 }
