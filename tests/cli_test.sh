@@ -24,9 +24,9 @@ grep -q "^$work/bad.scn:3:9: error: " "$work/err" && ok || bad "error format: $(
 [ "$(cat "$work/out.png")" = "precious" ] && ok || bad "output clobbered by a failed render"
 [ -z "$(ls "$work" | grep tmp)" ] && ok || bad "temporary file left behind"
 
-# Missing file and directory as input: status 2 with a located message.
+# Missing file and directory as input: status 2, the file named without a position.
 "$SNELL" render "$work/nope.scn" -o "$work/x.png" 2>"$work/err"; status=$?
-[ $status -eq 2 ] && grep -q "nope.scn:1:1: error:" "$work/err" && [ ! -e "$work/x.png" ] && ok || bad "missing file ($status)"
+[ $status -eq 2 ] && grep -q "nope.scn: error: cannot open scene file: No such file or directory" "$work/err" && [ ! -e "$work/x.png" ] && ok || bad "missing file ($status)"
 "$SNELL" render "$work" -o "$work/x.png" 2>"$work/err"; status=$?
 [ $status -eq 2 ] && grep -q "directory" "$work/err" && ok || bad "directory as input ($status)"
 
@@ -158,6 +158,10 @@ if command -v script >/dev/null; then
   script -qfec "$SNELL render $SCENES/showcase.scn --size 200 --spp 2 -o $work/prog.png" "$work/tty" >/dev/null 2>&1
   grep -q "elapsed" "$work/tty" && grep -q "Mrays/s" "$work/tty" && [ -s "$work/prog.png" ] && ok ||
     bad "no progress bar on a terminal: $(tr '\r' '\n' <"$work/tty" | head -3)"
+  # A render long enough for the bar to matter first estimates its rays from a
+  # sparse render of the same image (--verbose says how long that took).
+  script -qfec "$SNELL render $SCENES/basic.scn --size 2048 -v -o $work/prog3.png" "$work/tty" >/dev/null 2>&1
+  grep -q "estimate [0-9]* ms" "$work/tty" && [ -s "$work/prog3.png" ] && ok || bad "no ray estimate for the progress bar"
 fi
 "$SNELL" render "$SCENES/showcase.scn" --size 64 -o "$work/prog2.png" 2>"$work/err"
 ! grep -q "elapsed" "$work/err" && ok || bad "progress written to a non-terminal"
@@ -186,6 +190,59 @@ printf 'view 64 0.5\nlight 1 1 1 0 0 -3\ngroup\nmaterial 1 1 1 0 0 0 1\nmove 0 0
   grep -q "warn.scn:3:1: warning: 'group' is never closed" "$work/err" && grep -q "warn.scn:6:1: warning: light 1 .* inside" "$work/err" &&
   ok || bad "check (status $status): $(cat "$work/check" "$work/err")"
 "$SNELL" check "$work/bad.scn" >/dev/null 2>"$work/err"; [ $? -eq 2 ] && grep -q "bad.scn:3:9: error" "$work/err" && ok || bad "check of a bad scene"
+
+# Standard input: - reads the scene (pipes included); the image equals the
+# file's; errors name <stdin>; check reads it too.
+cat "$SCENES/basic.scn" | "$SNELL" render - --size 24 -q -o "$work/stdin.png" && "$SNELL" render "$SCENES/basic.scn" --size 24 -q -o "$work/file.png" &&
+  "$SNELL" compare "$work/stdin.png" "$work/file.png" --max-mean 0 --max-bad 0 >/dev/null && ok || bad "render - from a pipe"
+printf 'view 8 1\nsphere\nmove 1 x 2\n' | "$SNELL" render - -o "$work/x.png" 2>"$work/err"; status=$?
+[ $status -eq 2 ] && grep -q "^<stdin>:3:8: error: " "$work/err" && [ ! -e "$work/x.png" ] && ok || bad "error from stdin ($status): $(cat "$work/err")"
+"$SNELL" check - <"$SCENES/basic.scn" >"$work/out" 2>/dev/null && grep -q "^stdin: " "$work/out" && ok || bad "check -"
+
+# compare for scripts: 0 agree, 1 differ (thresholds can be set), 2 trouble;
+# --bound-image leaves out what the reference does not certify and says how many.
+"$SNELL" render "$SCENES/showcase.scn" --size 24 -q -o "$work/other.png"
+"$SNELL" compare "$work/other.png" "$work/file.png" >"$work/out"; status=$?
+[ $status -eq 1 ] && grep -q "^differ: " "$work/out" && ok || bad "compare of unrelated images: status $status"
+"$SNELL" compare "$work/other.png" "$work/file.png" --max-mean 255 --max-bad 100 >/dev/null && ok || bad "compare --max-mean/--max-bad"
+"$SNELL" compare "$work/nothing.png" "$work/file.png" 2>"$work/err"; status=$?
+[ $status -eq 2 ] && grep -q "snell: error: " "$work/err" && ok || bad "compare of a missing image: status $status"
+"$SNELL" compare "$work/basic.png" "$work/file.png" 2>"$work/err"; status=$?
+[ $status -eq 2 ] && grep -q "size" "$work/err" && ok || bad "compare of images of different sizes: status $status"
+"$SNELL" render "$SCENES/glass.scn" --size 32 -q --cpu --tolerance 0 --depth 3 -o "$work/ref.pfm" --bound-image "$work/bound.pfm" &&
+  "$SNELL" render "$SCENES/glass.scn" --size 32 -q -o "$work/test.pfm" && ok || bad "renders for --bound-image"
+"$SNELL" compare "$work/test.pfm" "$work/ref.pfm" --bound-image "$work/bound.pfm" --max-uncertain 100 --json >"$work/cmp"
+python3 - "$work/cmp" <<'PY' && ok || bad "compare --bound-image: $(cat "$work/cmp")"
+import json, sys
+m = json.load(open(sys.argv[1]))
+assert m["uncertain_pixels"] > 0 and m["pixels"] + m["uncertain_pixels"] == 32 * 32, m
+PY
+"$SNELL" compare "$work/test.pfm" "$work/ref.pfm" --bound-image "$work/bound.pfm" --max-uncertain 0 >"$work/out"; status=$?
+[ $status -eq 1 ] && grep -q "uncertain pixels" "$work/out" && grep -q "^left out [0-9]* uncertain" "$work/out" && ok ||
+  bad "compare --max-uncertain 0: status $status"
+
+# Typos on the command line get a suggestion and status 2, as typos in scenes do.
+"$SNELL" rendr "$SCENES/basic.scn" 2>"$work/err"; status=$?
+[ $status -eq 2 ] && grep -q "unknown command 'rendr'; did you mean 'render'?" "$work/err" && ok || bad "snell rendr ($status): $(cat "$work/err")"
+"$SNELL" render "$SCENES/basic.scn" --sise 64 -o "$work/x.png" 2>"$work/err"; status=$?
+[ $status -eq 2 ] && grep -q "did you mean '--size'?" "$work/err" && [ ! -e "$work/x.png" ] && ok || bad "--sise ($status): $(cat "$work/err")"
+"$SNELL" compare a.png b.png --max-men 1 2>"$work/err"; status=$?
+[ $status -eq 2 ] && grep -q "did you mean '--max-mean'?" "$work/err" && ok || bad "--max-men ($status): $(cat "$work/err")"
+
+# check and render give the same warnings: a sphere behind the camera, no light
+# and no ambient, a size that makes the render expensive.
+printf 'view 16 1\nmove 0 0 5\nsphere\n' >"$work/dark.scn"
+"$SNELL" check "$work/dark.scn" >/dev/null 2>"$work/check-warn"
+"$SNELL" render "$work/dark.scn" -o "$work/dark.png" 2>"$work/render-warn"
+grep -q "dark.scn:3:1: warning: this sphere is behind the camera" "$work/check-warn" &&
+  grep -q "dark.scn: warning: every sphere is behind the camera" "$work/check-warn" &&
+  grep -q "dark.scn: warning: no light and no ambient" "$work/check-warn" &&
+  diff "$work/check-warn" "$work/render-warn" >/dev/null && ok || bad "check and render warnings: $(cat "$work/check-warn" "$work/render-warn")"
+printf 'view 8192 1\nlight 1 1 1 0 0 5\nmove 0 0 -3\nsphere\n' >"$work/big.scn"
+"$SNELL" check "$work/big.scn" >/dev/null 2>"$work/err" && grep -q "big.scn: warning: this render traces 6.71e+07 camera rays.*--size 1024" "$work/err" &&
+  ok || bad "no warning of an expensive render: $(cat "$work/err")"
+"$SNELL" render "$work/big.scn" --size 64 -o "$work/big.png" 2>"$work/err" && [ ! -s "$work/err" ] && ok || bad "warned at a small size: $(cat "$work/err")"
+"$SNELL" render "$SCENES/basic.scn" --size 24 -o "$work/x.png" 2>"$work/err" && [ ! -s "$work/err" ] && ok || bad "warnings on a plain scene: $(cat "$work/err")"
 
 echo "cli: $pass passed, $fail failed"
 [ $fail -eq 0 ]

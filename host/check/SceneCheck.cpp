@@ -1,5 +1,9 @@
 #include "check/SceneCheck.h"
 
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
 #include <sstream>
 
 #include "bvh/Bvh.h"
@@ -22,6 +26,118 @@ std::string vec(const dvec3& v) {
 
 }  // namespace
 
+namespace {
+
+// A warning about the scene as a whole: no position (Diagnostic::format).
+Diagnostic aboutFile(const std::string& path, std::string message) {
+    Diagnostic d;
+    d.location.file = path;
+    d.location.line = d.location.column = 0;
+    d.message = std::move(message);
+    return d;
+}
+
+// Repeated warnings of one kind: the first few, then how many more.
+class WarningList {
+public:
+    explicit WarningList(std::vector<Diagnostic>& out) : out_(out) {}
+    void add(const SourceLocation& at, const std::string& message, const std::string& kind) {
+        if (++counts_[kind] <= kMaxPerKind) out_.push_back({at, message});
+        else lastFile_ = at.file;
+    }
+    void summarize(const std::string& kind, const std::string& what) {
+        if (counts_[kind] > kMaxPerKind)
+            out_.push_back(aboutFile(lastFile_, std::to_string(counts_[kind] - kMaxPerKind) + " more " + what + " not shown"));
+    }
+
+private:
+    static constexpr int kMaxPerKind = 10;
+    std::vector<Diagnostic>& out_;
+    std::map<std::string, int> counts_;
+    std::string lastFile_;
+};
+
+// Wholly behind the eye's plane: no camera ray can reach it (reflections may).
+bool behindCamera(const Sphere& s, const Camera& camera) {
+    const Aabb b = sphereBounds(s);
+    for (int corner = 0; corner < 8; ++corner) {
+        const dvec3 p{corner & 1 ? b.upper.x : b.lower.x, corner & 2 ? b.upper.y : b.lower.y,
+                      corner & 4 ? b.upper.z : b.lower.z};
+        if (glm::dot(p - camera.eye, camera.forward) >= 0.0) return false;
+    }
+    return true;
+}
+
+void warnAboutSpheres(const Scene& scene, const std::string& path, std::vector<Diagnostic>& out) {
+    // Lights inside spheres: every pair, unless that is too much work for a warning.
+    constexpr double kMaxPairs = 5e7;
+    const bool pairs = double(scene.spheres.size()) * double(scene.lights.size()) <= kMaxPairs;
+    const Camera camera = Camera::fromSpec(std::max(1, scene.imageSize), scene.halfWidth);
+    WarningList list(out);
+    std::size_t behind = 0;
+    for (const Sphere& s : scene.spheres) {
+        const SourceLocation at{path, s.location.line, s.location.column};
+        for (std::size_t j = 0; pairs && j < scene.lights.size(); ++j) {
+            if (inside(s, scene.lights[j].position))
+                list.add(at, "light " + std::to_string(j + 1) + " (at " + vec(scene.lights[j].position) +
+                                 ") is inside this sphere, so it lights only the sphere's inside (shadows are "
+                                 "binary: a transparent sphere blocks light too); move the light out of it",
+                         "light");
+        }
+        if (behindCamera(s, camera)) {
+            ++behind;
+            list.add(at, "this sphere is behind the camera (only reflections can show it); the camera looks "
+                         "down -z from (0, 0, 1)",
+                     "behind");
+        }
+    }
+    list.summarize("light", "lights inside spheres");
+    list.summarize("behind", "spheres behind the camera");
+    if (behind == scene.spheres.size())
+        out.push_back(aboutFile(path, std::string(scene.spheres.empty() ? "the scene has no sphere"
+                                                                         : "every sphere is behind the camera") +
+                                          ": the image will be the background colour; spheres in front of the "
+                                          "camera have z < 1 (the eye is at (0, 0, 1), looking down -z)"));
+}
+
+// No light and no ambient: the spheres' own terms are black, and they can
+// only show the background through reflection and refraction.
+void warnAboutDarkness(const Scene& scene, const std::string& path, std::vector<Diagnostic>& out) {
+    const bool lit = std::any_of(scene.lights.begin(), scene.lights.end(),
+                                 [](const Light& l) { return l.colour != dvec3(0.0); });
+    if (lit || scene.ambient != dvec3(0.0) || scene.spheres.empty()) return;
+    const bool showsBackground = scene.background != dvec3(0.0) && (scene.anyReflection() || scene.anyRefraction());
+    out.push_back(aboutFile(path, std::string("no light and no ambient: every sphere renders black") +
+                                      (showsBackground ? " except where it reflects or refracts the background" : "") +
+                                      "; add a 'light r g b x y z' or an 'ambient r g b'"));
+}
+
+// The image's size alone makes the render expensive: say so before it starts.
+void warnAboutCost(const RenderShape& shape, const std::string& path, std::vector<Diagnostic>& out) {
+    constexpr double kManyCameraRays = 16.8e6;  // above 4096 x 4096 at one sample
+    constexpr double kPreviewCameraRays = 1 << 20;
+    const double cameraRays = double(shape.size) * shape.size * shape.supersample * shape.supersample;
+    if (cameraRays <= kManyCameraRays) return;
+    const int previewSize = std::max(1, int(std::sqrt(kPreviewCameraRays) / shape.supersample));
+    char text[400];
+    std::snprintf(text, sizeof text,
+                  "this render traces %.3g camera rays (%dx%d pixels, %d sample(s) each), each with its shadow, "
+                  "reflected and refracted rays: minutes on a CPU Vulkan driver; --size %d previews it %.0fx faster",
+                  cameraRays, shape.size, shape.size, shape.supersample * shape.supersample, previewSize,
+                  cameraRays / (double(previewSize) * previewSize * shape.supersample * shape.supersample));
+    out.push_back(aboutFile(path, text));
+}
+
+}  // namespace
+
+std::vector<Diagnostic> sceneWarnings(const Scene& scene, const std::string& path, RenderShape shape) {
+    std::vector<Diagnostic> out = scene.warnings;
+    warnAboutSpheres(scene, path, out);
+    warnAboutDarkness(scene, path, out);
+    warnAboutCost(shape, path, out);
+    return out;
+}
+
 SceneReport checkScene(const Scene& scene, const std::string& path) {
     SceneReport r;
     r.spheres = scene.spheres.size();
@@ -29,26 +145,14 @@ SceneReport checkScene(const Scene& scene, const std::string& path) {
     r.trueSpheres = r.spheres - r.ellipsoids;
     r.lights = scene.lights.size();
     r.materials = scene.materials.size();
-    r.warnings = scene.warnings;
+    r.warnings = sceneWarnings(scene, path, {scene.imageSize, scene.supersample});
     r.amplifying = scene.anyAmplifying();
     Aabb box;
-    const Camera camera = Camera::fromSpec(std::max(1, scene.imageSize), scene.halfWidth);
     for (const Sphere& s : scene.spheres) {
         const Material& m = scene.materials[s.material];
         r.reflective += m.reflects();
         r.refractive += m.refracts();
-        const Aabb b = sphereBounds(s);
-        box.grow(b);
-        const SourceLocation at{path, s.location.line, s.location.column};
-        for (std::size_t j = 0; j < scene.lights.size(); ++j) {
-            if (inside(s, scene.lights[j].position))
-                r.warnings.push_back({at, "light " + std::to_string(j + 1) + " (at " + vec(scene.lights[j].position) +
-                                              ") is inside this sphere" +
-                                              (m.refracts() ? "" : ", which is opaque: it lights only its inside")});
-        }
-        // Wholly behind the eye: no primary ray can see it (it may still be reflected).
-        if (glm::dot(s.centre - camera.eye, camera.forward) < -s.radius)
-            r.warnings.push_back({at, "this sphere is behind the camera (only reflections can show it)"});
+        box.grow(sphereBounds(s));
     }
     if (!scene.spheres.empty()) {
         r.lower = box.lower;

@@ -14,12 +14,25 @@ struct SceneReport {
     std::size_t materials = 0, reflective = 0, refractive = 0;  // spheres with ks > 0 / kt > 0
     bool amplifying = false;
     dvec3 lower{0.0}, upper{0.0};  // bounding box of all spheres (zero when there are none)
-    std::vector<Diagnostic> warnings;  // the parser's, then lights inside spheres, spheres behind the camera
+    std::vector<Diagnostic> warnings;  // sceneWarnings at the scene's own size
     std::string json(const Scene& scene) const;
     std::string text(const Scene& scene) const;
 };
 
-// `path`: the scene's file, for the warnings' locations.
+// What a render of the scene will be: its image size and supersampling.
+struct RenderShape {
+    int size = 0;
+    int supersample = 1;
+};
+
+// What looks wrong in a scene, the same for `check` and `render` (one set of
+// warnings, one set of thresholds), each saying what to do: the parser's;
+// lights inside spheres; spheres behind the camera; a scene that can only
+// render the background or black; a render whose size alone makes it
+// expensive. `path`: the scene's file, for the warnings' locations.
+std::vector<Diagnostic> sceneWarnings(const Scene& scene, const std::string& path, RenderShape shape);
+
+// The report of `snell check`: warnings at the scene's own size.
 SceneReport checkScene(const Scene& scene, const std::string& path);
 
 }  // namespace snell

@@ -14,47 +14,84 @@ std::string ImageMetrics::json() const {
     std::snprintf(buffer, sizeof buffer,
                   "{\"mean_abs_error\": %.6f, \"rmse\": %.6f, \"psnr\": %s, \"max_error\": %d, "
                   "\"bad_pixels\": %llu, \"bad_fraction\": %.8f, \"non_finite\": %llu, \"speckles\": %llu, "
-                  "\"pixels\": %llu}",
+                  "\"pixels\": %llu, \"uncertain_pixels\": %llu}",
                   meanAbsError, rmse, std::isfinite(psnr) ? std::to_string(psnr).c_str() : "null", maxError,
                   static_cast<unsigned long long>(badPixels), badFraction,
                   static_cast<unsigned long long>(nonFinite), static_cast<unsigned long long>(speckles),
-                  static_cast<unsigned long long>(pixels));
+                  static_cast<unsigned long long>(pixels), static_cast<unsigned long long>(uncertain));
     return buffer;
 }
 
-ImageMetrics compareImages(const Image& test, const Image& reference, int badThreshold) {
-    if (test.width != reference.width || test.height != reference.height)
-        throw std::invalid_argument("images differ in size: " + std::to_string(test.width) + "x" +
-                                    std::to_string(test.height) + " against " +
-                                    std::to_string(reference.width) + "x" + std::to_string(reference.height));
+namespace {
+
+void requireSameSize(const Image& a, const Image& b, const char* what) {
+    if (a.width != b.width || a.height != b.height)
+        throw std::invalid_argument(std::string(what) + " differ in size: " + std::to_string(a.width) + "x" +
+                                    std::to_string(a.height) + " against " + std::to_string(b.width) + "x" +
+                                    std::to_string(b.height));
+}
+
+// The largest channel difference of pixel p in 1/255 units, counting non-finite values.
+int worstDifference(const Image& test, const Image& reference, std::size_t p, std::uint64_t& nonFinite) {
+    int worst = 0;
+    for (int k = 0; k < 3; ++k) {
+        const float a = test.rgb[p * 3 + k];
+        if (!std::isfinite(a)) ++nonFinite;
+        worst = std::max(worst, std::abs(int(toByte(a)) - int(toByte(reference.rgb[p * 3 + k]))));
+    }
+    return worst;
+}
+
+// Off by more than 8/255 while all eight neighbours are within 2/255.
+std::uint64_t countSpeckles(const std::vector<int>& worstOf, int width, int height) {
+    std::uint64_t speckles = 0;
+    for (int y = 1; y + 1 < height; ++y) {
+        for (int x = 1; x + 1 < width; ++x) {
+            if (worstOf[std::size_t(y) * width + x] <= 8) continue;
+            bool isolated = true;
+            for (int dy = -1; dy <= 1; ++dy)
+                for (int dx = -1; dx <= 1; ++dx)
+                    if ((dx || dy) && worstOf[std::size_t(y + dy) * width + (x + dx)] > 2) isolated = false;
+            speckles += isolated;
+        }
+    }
+    return speckles;
+}
+
+}  // namespace
+
+ImageMetrics compareImages(const Image& test, const Image& reference, int badThreshold, const Image* referenceBound) {
+    requireSameSize(test, reference, "images");
+    if (referenceBound) requireSameSize(*referenceBound, reference, "the bound image and the reference");
     ImageMetrics m;
-    m.pixels = static_cast<std::uint64_t>(test.width) * test.height;
-    std::vector<int> worstOf(m.pixels, 0);
+    const std::size_t pixels = static_cast<std::size_t>(test.width) * test.height;
+    std::vector<int> worstOf(pixels, 0);
     double sum = 0.0, sumSquares = 0.0;
-    for (std::size_t p = 0; p < m.pixels; ++p) {
-        int worst = 0;
+    for (std::size_t p = 0; p < pixels; ++p) {
+        const int worst = worstDifference(test, reference, p, m.nonFinite);
+        if (referenceBound) {
+            const float* b = &referenceBound->rgb[p * 3];
+            const double bound = 255.0 * std::max({b[0], b[1], b[2]});
+            // NaN or an unclamped bound never certifies; a bound cannot excuse a NaN.
+            const bool certified = bound <= 0.5;
+            const bool provenWrong = double(worst) > std::ceil(bound) + badThreshold || !std::isfinite(test.rgb[p * 3]) ||
+                                     !std::isfinite(test.rgb[p * 3 + 1]) || !std::isfinite(test.rgb[p * 3 + 2]);
+            if (!certified && !provenWrong) {
+                ++m.uncertain;
+                continue;
+            }
+        }
         for (int k = 0; k < 3; ++k) {
-            const float a = test.rgb[p * 3 + k];
-            if (!std::isfinite(a)) ++m.nonFinite;
-            const int diff = std::abs(int(toByte(a)) - int(toByte(reference.rgb[p * 3 + k])));
+            const int diff = std::abs(int(toByte(test.rgb[p * 3 + k])) - int(toByte(reference.rgb[p * 3 + k])));
             sum += diff;
             sumSquares += double(diff) * diff;
-            worst = std::max(worst, diff);
         }
         worstOf[p] = worst;
         m.maxError = std::max(m.maxError, worst);
         if (worst > badThreshold) ++m.badPixels;
     }
-    for (int y = 1; y + 1 < test.height; ++y) {
-        for (int x = 1; x + 1 < test.width; ++x) {
-            if (worstOf[std::size_t(y) * test.width + x] <= 8) continue;
-            bool isolated = true;
-            for (int dy = -1; dy <= 1; ++dy)
-                for (int dx = -1; dx <= 1; ++dx)
-                    if ((dx || dy) && worstOf[std::size_t(y + dy) * test.width + (x + dx)] > 2) isolated = false;
-            m.speckles += isolated;
-        }
-    }
+    m.pixels = pixels - m.uncertain;
+    m.speckles = countSpeckles(worstOf, test.width, test.height);
     const double n = m.pixels ? 3.0 * m.pixels : 1.0;
     m.meanAbsError = sum / n;
     m.rmse = std::sqrt(sumSquares / n);

@@ -20,12 +20,19 @@ struct ImageMetrics {
     // Isolated errors: off by more than 8/255 while all eight neighbours are
     // within 2/255 (acne and self-intersection show up as these).
     std::uint64_t speckles = 0;
-    std::uint64_t pixels = 0;
+    std::uint64_t pixels = 0;     // pixels compared (uncertain ones left out)
+    std::uint64_t uncertain = 0;  // left out: the reference's bound cannot decide them
     std::string json() const;
 };
 
 // Compare `test` against `reference` (same size, else std::invalid_argument).
-ImageMetrics compareImages(const Image& test, const Image& reference, int badThreshold = 3);
+// With `referenceBound` (render --bound-image of the reference: how far each
+// reference pixel may be from the exact image, per channel), a pixel the
+// reference does not certify in 8 bits (bound over half a step, SPEC §6) is
+// left out and counted as uncertain, unless the test is off by more than
+// the bound allows plus the bad threshold: the bound proves that one wrong.
+ImageMetrics compareImages(const Image& test, const Image& reference, int badThreshold = 3,
+                           const Image* referenceBound = nullptr);
 
 // A false-colour difference image: black where equal, blue → red as the
 // largest channel difference grows to `fullScale`/255.

@@ -1,0 +1,55 @@
+// `snell bench`: speed against error over a set of scenes (host/bench/).
+#include <filesystem>
+#include <iostream>
+
+#include "bench/Bench.h"
+#include "cli/Command.h"
+#include "cli/ExitStatus.h"
+
+namespace snell::cli {
+namespace {
+
+class BenchCommand : public Command {
+public:
+    CLI::App* define(CLI::App& app) override {
+        CLI::App* c = app.add_subcommand(
+            "bench",
+            "Speed against error: sweep settings, compare with peers, write CSV and JSON (bench/summarize.py: "
+            "tables, plot)");
+        c->add_option("scenes", o_.scenes,
+                      "Scene files or directories (default: scenes/, scenes/hard/, the course and bench scenes)");
+        c->add_flag("--quick", o_.quick, "A small, fast run (CI): scenes/ and the bench scenes at 32x32, fewer settings");
+        c->add_option("-s,--size", o_.size, "Image size (default 128; quick 32)")->check(CLI::Range(8, 4096));
+        c->add_option("--runs", o_.runs, "Timed runs per setting after a warm-up (at least 5)")
+            ->check(CLI::Range(5, 1000));
+        c->add_option("-o,--out", o_.outDir, "Directory for bench.csv and bench.json (default bench/results)");
+        c->add_option("--source-dir", o_.sourceDir,
+                      "The snell repository (default: . if it has scenes/, else the build's)");
+        c->add_option("--shared-dir", o_.sharedDir,
+                      "Where course-scenes/ and bench-scenes/ are (default SOURCE/../shared)");
+        c->add_option("--gpu", o_.gpu, "Vulkan device index")->envname("SNELL_GPU")->check(CLI::NonNegativeNumber);
+        return c;
+    }
+
+    int run() override {
+        namespace fs = std::filesystem;
+        // The repository: the working directory when it has scenes/, else where snell was built from.
+        if (o_.sourceDir.empty())
+            o_.sourceDir = fs::exists("scenes") && fs::exists("bench") ? "." : SNELL_SOURCE_DIR;
+        if (o_.sharedDir.empty()) o_.sharedDir = (fs::path(o_.sourceDir) / ".." / "shared").string();
+        std::error_code ec;
+        o_.snellPath = fs::read_symlink("/proc/self/exe", ec).string();
+        o_.cancel = interruptFlag();
+        runBench(o_, std::cerr);
+        return kExitSuccess;
+    }
+
+private:
+    BenchOptions o_;
+};
+
+}  // namespace
+
+std::unique_ptr<Command> makeBenchCommand() { return std::make_unique<BenchCommand>(); }
+
+}  // namespace snell::cli

@@ -1,0 +1,31 @@
+// `snell devices`: the Vulkan devices and why any cannot be used.
+#include <iostream>
+
+#include "cli/Command.h"
+#include "cli/ExitStatus.h"
+#include "vulkan/VulkanContext.h"
+
+namespace snell::cli {
+namespace {
+
+class DevicesCommand : public Command {
+public:
+    CLI::App* define(CLI::App& app) override {
+        return app.add_subcommand("devices", "List the Vulkan devices and why any cannot be used");
+    }
+
+    int run() override {
+        const auto reports = vk::Context::listDevices();
+        if (reports.empty()) throw std::runtime_error("no Vulkan device found: apt-get install mesa-vulkan-drivers");
+        for (const auto& r : reports)
+            std::cout << r.index << ": " << r.name << " (" << r.type << ", " << r.driver << ")"
+                      << (r.usable ? "" : " — unusable: " + r.reason) << "\n";
+        return kExitSuccess;
+    }
+};
+
+}  // namespace
+
+std::unique_ptr<Command> makeDevicesCommand() { return std::make_unique<DevicesCommand>(); }
+
+}  // namespace snell::cli

@@ -1,0 +1,61 @@
+// Option groups and inputs shared by snell's subcommands, defined once.
+#pragma once
+
+#include <optional>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "gpu/GpuScene.h"
+#include "scene/Scene.h"
+#include "vulkan/VulkanContext.h"
+
+namespace snell::cli {
+
+// The output's format comes from its extension; an unknown one is a command-line error.
+extern const CLI::Validator kImageFormat;
+// CLI11's Range lets NaN through (every comparison with it is false).
+extern const CLI::Validator kFinite;
+
+// Which Vulkan device renders, and how: --gpu, --precision, --validation.
+struct DeviceOptions {
+    int gpu = -1;
+    std::string precision = "fp32";
+    bool validation = false;
+    gpu::Precision arithmetic() const { return precision == "fp64" ? gpu::Precision::Fp64 : gpu::Precision::Fp32; }
+};
+void addDeviceOptions(CLI::App& command, DeviceOptions& options);
+
+// The ray tree a pixel traces: --depth, --min-weight, --spp. The defaults
+// differ between commands, so each says its own in the help.
+struct TreeOptions {
+    std::optional<int> depth;
+    std::optional<double> minWeight;
+    std::optional<int> supersample;
+};
+struct TreeHelp {
+    std::string depth, minWeight;
+    int maxDepth;
+};
+void addTreeOptions(CLI::App& command, TreeOptions& options, const TreeHelp& help);
+
+// The scene argument: a file, or - for standard input (named <stdin> in
+// messages; its default output is stdin.png). Throws ParseError.
+Scene readScene(const std::string& argument);
+// The scene argument as messages name it.
+inline std::string sceneFile(const std::string& argument) { return argument == "-" ? "<stdin>" : argument; }
+// Help text of a scene argument.
+inline constexpr const char* kSceneHelp = "Scene file; - reads it from standard input";
+
+// Compiled pipelines persist here between runs: $SNELL_CACHE_DIR, else
+// $XDG_CACHE_HOME/snell, else ~/.cache/snell; empty (no cache) if none is set.
+std::string pipelineCachePath();
+
+// Testing hooks (docs/testing.md, "Faults and limits"), read from the
+// environment; a malformed value is an InputError. $SNELL_INJECT_FAULT
+// simulates a failing GPU; $SNELL_LOOP_BUDGET runs the shader's
+// suspend-and-resume path with that loop budget (0: unset).
+vk::FaultInjection faultInjection();
+std::uint32_t loopBudgetOverride();
+
+}  // namespace snell::cli

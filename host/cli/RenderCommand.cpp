@@ -1,0 +1,449 @@
+// `snell render`: a scene to an image, on the GPU or with the CPU reference.
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <memory>
+#include <sstream>
+#include <thread>
+
+#include "check/SceneCheck.h"
+#include "cli/Command.h"
+#include "cli/ExitStatus.h"
+#include "cli/Options.h"
+#include "cli/Progress.h"
+#include "common/Json.h"
+#include "gpu/ComputeRenderer.h"
+#include "image/BackgroundWriter.h"
+#include "image/ImageIO.h"
+#include "reference/CpuRenderer.h"
+#include "scene/Parser.h"
+#include "vulkan/VulkanContext.h"
+
+#ifndef SNELL_VERSION
+#define SNELL_VERSION "0.0.0"
+#endif
+
+namespace snell::cli {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double msSince(Clock::time_point start) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+struct RenderOptions {
+    std::string scene;
+    std::string output;
+    bool cpu = false;
+    std::optional<int> size;
+    TreeOptions tree;
+    std::optional<double> tolerance;
+    std::optional<std::uint64_t> treeBudget;
+    std::string boundImage;
+    std::vector<int> region;  // X0 Y0 X1 Y1, or empty
+    bool allowRunaway = false;
+    DeviceOptions device;
+    bool stats = false;
+    bool quiet = false;
+    bool verbose = false;
+};
+
+// Where the render may still differ from the exact image (SPEC §4 limit):
+// pixels whose dropped light has no finite bound, or whose tree was stopped.
+void printTruncationWarnings(const TruncationReport& t, const TraceSettings& settings) {
+    // ", e.g. (x, y), ...", or nothing where the renderer kept no coordinates
+    // (the GPU counts its over-budget pixels only).
+    auto examples = [](const std::vector<std::array<int, 2>>& pixels, std::uint64_t count) {
+        std::string s;
+        for (const auto& p : pixels)
+            s += (s.empty() ? "" : ", ") + ("(" + std::to_string(p[0]) + ", " + std::to_string(p[1]) + ")");
+        if (s.empty()) return s;
+        if (count > pixels.size()) s += ", ...";
+        return ", e.g. " + s;
+    };
+    if (t.unbounded > t.estimated)
+        std::cerr << "snell: warning: " << t.unbounded - t.estimated
+                  << " pixel(s) dropped light of a material with ks + kt >= 1, which need not decay, and their "
+                  << "colour had not settled at the floor cut-off: their bound is only the clamp to 1 "
+                  << "(--bound-image shows it)" << examples(t.unboundedExamples, t.unbounded) << "\n";
+    if (t.overBudget > 0)
+        std::cerr << "snell: warning: " << t.overBudget << " pixel(s) reached the tree budget of "
+                  << settings.treeBudget << " rays a sample and were stopped (their bound says by how much they "
+                  << "may still move)" << examples(t.overBudgetExamples, t.overBudget) << "\n";
+    if (t.overTolerance > t.unbounded)
+        std::cerr << "snell: warning: " << t.overTolerance << " pixel(s) are above the tolerance "
+                  << settings.tolerance << " at the floor cut-off " << settings.minWeight
+                  << " (largest bound " << t.maxBound << ")\n";
+}
+
+std::string truncationJson(const TruncationReport& t) {
+    std::ostringstream j;
+    j.precision(6);
+    j << "{\"max_bound\": " << t.maxBound << ", \"mean_bound\": " << t.meanBound()
+      << ", \"unbounded_pixels\": " << t.unbounded << ", \"over_budget_pixels\": " << t.overBudget
+      << ", \"over_tolerance_pixels\": " << t.overTolerance << ", \"estimated_pixels\": " << t.estimated
+      << ", \"max_estimated_error\": " << t.maxEstimate << ", \"deepest_ray\": " << t.deepest << "}";
+    return j.str();
+}
+
+// What the renderer did, for --verbose and --stats.
+struct RenderOutcome {
+    RayCounts rays;
+    std::string device;
+    std::string timing = "host";  // how renderMs was measured
+    double uploadMs = 0, pipelineMs = 0, renderMs = 0, readbackMs = 0;
+    double estimateMs = 0;  // the progress bar's sparse render (estimateRays)
+    int tiles = 0, dispatches = 0;
+};
+
+// For the progress bar's time left: the rays the render will trace, from a
+// render of one pixel in 256 (every 16th row and column of the same image,
+// so as uneven as it), costing about 1/256 of the render. Only for renders
+// long enough to show a bar for a while.
+template <class Render>
+void estimateRays(const Scene& scene, const RenderRequest& request, Progress& progress, RenderOutcome& outcome,
+                  Render render) {
+    constexpr int kStride = 16;
+    constexpr double kMinCameraRays = 1 << 22;
+    const PixelWindow area = request.area();
+    const double cameraRays = double(area.width()) * area.height() * request.supersample * request.supersample;
+    if (cameraRays < kMinCameraRays) return;
+    RenderRequest probe;
+    probe.width = probe.height = std::max(1, request.width / kStride);
+    probe.camera = Camera::fromSpec(probe.width, scene.halfWidth);
+    probe.window = {area.x0 / kStride, area.y0 / kStride, std::max(area.x1 / kStride, area.x0 / kStride + 1),
+                    std::max(area.y1 / kStride, area.y0 / kStride + 1)};
+    probe.supersample = request.supersample;
+    probe.trace = request.trace;
+    probe.cancel = request.cancel;
+    // The CPU reports from its worker threads: keep the largest count seen.
+    std::atomic<std::uint64_t> rays{0};
+    probe.progress = [&rays](double, std::uint64_t traced) {
+        for (std::uint64_t seen = rays.load(); seen < traced && !rays.compare_exchange_weak(seen, traced);) {
+        }
+    };
+    const auto start = Clock::now();
+    render(probe);
+    outcome.estimateMs = msSince(start);
+    const PixelWindow sampled = probe.area();
+    progress.expectRays(double(rays.load()) * double(area.width()) * area.height() /
+                        (double(sampled.width()) * sampled.height()));
+}
+
+// The image streams to a temporary file beside the output as bands of rows
+// finish, encoded on a thread of its own (BackgroundWriter) while the render
+// goes on; it replaces the output only when complete (no lost output).
+class OutputStream {
+public:
+    OutputStream(const std::string& path, const Scene& scene, const RenderOptions& o, const RenderRequest& request);
+    // The RenderRequest's row sink; keeps the first error for commit().
+    std::function<void(const float*, int)> sink();
+    void commit();
+    double encodeMs() const { return writer_->encodeMs(); }    // spent encoding, mostly during the render
+    double blockedMs() const { return writer_->blockedMs(); }  // the render's wait for it, and the wait after it
+
+private:
+    std::unique_ptr<BackgroundWriter> writer_;
+    std::string error_;
+};
+
+class RenderCommand : public Command {
+public:
+    CLI::App* define(CLI::App& app) override;
+    int run() override;
+
+private:
+    RenderRequest makeRequest(const Scene& scene) const;
+    TraceSettings traceSettings() const;
+    void refuseRunawayTrees(const Scene& scene, const TraceSettings& trace) const;
+    RenderOutcome renderOnCpu(const Scene& scene, RenderRequest& request, const OutputStream& stream,
+                              Progress& progress) const;
+    RenderOutcome renderOnGpu(const Scene& scene, RenderRequest& request, Progress& progress) const;
+    void writeBoundImage(const RenderRequest& request, const std::vector<float>& bound) const;
+    std::string statsJson(const Scene& scene, const RenderRequest& request, const RenderOutcome& r,
+                          const std::string& output, double parseMs, const OutputStream& stream, double totalMs) const;
+
+    RenderOptions o_;
+    TruncationReport truncation_;
+};
+
+CLI::App* RenderCommand::define(CLI::App& app) {
+    CLI::App* c = app.add_subcommand("render", "Render a scene file to an image (PNG, PPM, PFM or EXR by extension)");
+    c->add_option("scene", o_.scene, kSceneHelp)->required();
+    c->add_option("-o,--output", o_.output,
+                  "Output image: .png, .ppm (P6), .pfm or .exr (float); - for PPM on standard output; default "
+                  "SCENE.png")
+        ->check(kImageFormat);
+    c->add_flag("--cpu", o_.cpu, "Render with the double-precision CPU reference instead of the GPU");
+    c->add_option("-s,--size", o_.size, "Image size in pixels (overrides the scene's view n)")
+        ->check(CLI::Range(1, ParseLimits::kMaxImageSize));
+    addTreeOptions(*c, o_.tree,
+                   {"Maximum reflection/refraction depth; without --tolerance, a fixed tree of this depth traced "
+                    "once (default: 10000, a safety cap: the tolerance decides)",
+                    "Stop rays whose weight falls below W; without --tolerance, a fixed tree traced once; with it, "
+                    "the lowest cut-off tried (default: GPU 1e-5, CPU 1e-7)",
+                    100000});
+    c->add_option("--tolerance", o_.tolerance,
+                  "Trace each pixel until what its cut-offs may have lost is at most T (where no bound exists: until "
+                  "its estimated error is); 0: a fixed tree (default: GPU 0.5/255 = 0.00196, exact in 8 bits; "
+                  "CPU 0.01/255; 0 when --depth or --min-weight is given alone)")
+        ->check(kFinite)->check(CLI::Range(0.0, 1.0));
+    c->add_option("--tree-budget", o_.treeBudget,
+                  "Stop a pixel's ray trees after N rays a sample and report the pixel; 0: no limit (default: 65536)")
+        ->check(CLI::NonNegativeNumber);
+    c->add_flag("--allow-runaway", o_.allowRunaway,
+                "Trace even when the settings allow a ray tree of astronomical size (no tree budget, and "
+                "amplifying materials or no cut-off): the render may never end");
+    c->add_option("--bound-image", o_.boundImage,
+                  "Also write each pixel's truncation bound (how far it may be from the exact image) to FILE "
+                  "(.pfm or .exr keep it unclamped)")
+        ->check(kImageFormat);
+    c->add_option("--region", o_.region,
+                  "Render only pixels X0..X1-1, Y0..Y1-1 of the image, as an image of that window (for a "
+                  "render farm: join the pieces with 'snell assemble')")
+        ->expected(4)->check(CLI::NonNegativeNumber);
+    addDeviceOptions(*c, o_.device);
+    c->add_flag("--stats", o_.stats,
+                "Print timings and ray counts as one JSON object on the last line of stdout (stderr with -o -)");
+    c->add_flag("-q,--quiet", o_.quiet, "No warnings or progress on stderr");
+    c->add_flag("-v,--verbose", o_.verbose, "Say on stderr which device rendered and where the time went");
+    return c;
+}
+
+int RenderCommand::run() {
+    const auto totalStart = Clock::now();
+    const auto parseStart = Clock::now();
+    const Scene scene = readScene(o_.scene);
+    const double parseMs = msSince(parseStart);
+    RenderRequest request = makeRequest(scene);
+    if (!o_.quiet)
+        for (const Diagnostic& w : sceneWarnings(scene, sceneFile(o_.scene), {request.width, request.supersample}))
+            std::cerr << w.format("warning") << "\n";
+
+    const std::string output = o_.output.empty() ? scene.name + ".png" : o_.output;
+    checkWritable(output);
+    request.truncation = &truncation_;
+    std::vector<float> bound;
+    if (!o_.boundImage.empty()) request.boundImage = &bound;
+    request.cancel = interruptFlag();
+    Progress progress(!o_.quiet);
+    request.progress = progress.callback();
+    OutputStream stream(output, scene, o_, request);
+    request.rowSink = stream.sink();
+
+    const RenderOutcome outcome =
+        o_.cpu ? renderOnCpu(scene, request, stream, progress) : renderOnGpu(scene, request, progress);
+    progress.done();
+    if (interrupted()) throw Interrupted("no image written");
+    stream.commit();
+    if (!o_.boundImage.empty()) writeBoundImage(request, bound);
+
+    if (!o_.quiet) printTruncationWarnings(truncation_, request.trace);
+    if (o_.verbose)
+        std::fprintf(stderr,
+                     "snell: %s: %dx%d, %s on %s\n"
+                     "snell: parse %.1f ms, upload %.1f ms, pipeline %.1f ms, render %.1f ms (%s, %d tiles, %d "
+                     "dispatches), readback %.1f ms, write %.1f ms (%.1f ms of it not overlapped)%s; %.1f ms in all\n",
+                     output.c_str(), request.width, request.height,
+                     o_.cpu ? "CPU reference" : o_.device.precision.c_str(), outcome.device.c_str(), parseMs,
+                     outcome.uploadMs, outcome.pipelineMs, outcome.renderMs, outcome.timing.c_str(), outcome.tiles,
+                     outcome.dispatches, outcome.readbackMs, stream.encodeMs(), stream.blockedMs(),
+                     outcome.estimateMs > 0 ? (", estimate " + std::to_string(int(outcome.estimateMs)) + " ms").c_str() : "",
+                     msSince(totalStart));
+    if (o_.stats) {
+        // With the image on standard output, the statistics go to standard error.
+        std::ostream& out = output == kStandardOutput ? std::cerr : std::cout;
+        out << statsJson(scene, request, outcome, output, parseMs, stream, msSince(totalStart))
+            << std::endl;
+    }
+    return kExitSuccess;
+}
+
+TraceSettings RenderCommand::traceSettings() const {
+    TraceSettings trace = o_.cpu ? kReferenceSettings : kDefaultSettings;
+    if (o_.tree.depth) trace.maxDepth = *o_.tree.depth;
+    if (o_.tree.minWeight) trace.minWeight = *o_.tree.minWeight;
+    // A depth or a cut-off without a tolerance asks for that tree, traced
+    // once (POV-Ray's max_trace_level and adc_bailout); with a tolerance they
+    // are its cap and floor.
+    if ((o_.tree.depth || o_.tree.minWeight) && !o_.tolerance) trace.tolerance = 0.0;
+    if (o_.tolerance) trace.tolerance = *o_.tolerance;
+    if (o_.treeBudget) trace.treeBudget = *o_.treeBudget;
+    return trace;
+}
+
+RenderRequest RenderCommand::makeRequest(const Scene& scene) const {
+    RenderRequest request;
+    const int size = o_.size.value_or(scene.imageSize);
+    request.width = request.height = size;
+    request.supersample = o_.tree.supersample.value_or(scene.supersample);
+    request.camera = Camera::fromSpec(size, scene.halfWidth);
+    request.trace = traceSettings();
+    refuseRunawayTrees(scene, request.trace);
+    if (!o_.region.empty()) {
+        const PixelWindow w{o_.region[0], o_.region[1], o_.region[2], o_.region[3]};
+        if (w.x0 < 0 || w.y0 < 0 || w.x1 > size || w.y1 > size || w.empty())
+            throw InputError("--region " + std::to_string(w.x0) + " " + std::to_string(w.y0) + " " +
+                             std::to_string(w.x1) + " " + std::to_string(w.y1) + " is not a window of the " +
+                             std::to_string(size) + "x" + std::to_string(size) + " image (want 0 <= X0 < X1 <= " +
+                             std::to_string(size) + ", 0 <= Y0 < Y1 <= " + std::to_string(size) + ")");
+        request.window = w;
+    }
+    return request;
+}
+
+// No runaway trees: without a tree budget, the settings must bound each
+// sample's tree to a size that finishes (render/Truncation.h).
+void RenderCommand::refuseRunawayTrees(const Scene& scene, const TraceSettings& trace) const {
+    constexpr double kMaxLog2Rays = 32;  // 4·10⁹ rays a sample
+    if (trace.treeBudget != 0 || o_.allowRunaway) return;
+    const TreeSizeBound tree = treeSizeBound(scene, trace.maxDepth, trace.minWeight);
+    if (tree.log2Rays <= kMaxLog2Rays) return;
+    std::ostringstream m;
+    m << "the material of this sphere has ks + kt = " << tree.gain << " in a channel; with --depth " << trace.maxDepth
+      << ", --min-weight " << trace.minWeight << " and --tree-budget 0 a sample's ray tree can grow "
+      << (std::isinf(tree.log2Rays) ? std::string("without bound")
+                                    : "up to 2^" + std::to_string(int(tree.log2Rays)) + " rays")
+      << ", and the render may never end. Use --tree-budget " << kDefaultSettings.treeBudget << " (the default)";
+    if (tree.gain <= 1.0) m << " or --min-weight " << kDefaultSettings.minWeight;
+    m << ", or --allow-runaway to trace it anyway";
+    const TextPosition at = scene.spheres[tree.sphere].location;
+    throw ParseError(Diagnostic{{sceneFile(o_.scene), at.line, at.column}, m.str()});
+}
+
+RenderOutcome RenderCommand::renderOnCpu(const Scene& scene, RenderRequest& request, const OutputStream& stream,
+                                         Progress& progress) const {
+    RenderOutcome r;
+    CpuRenderer renderer(scene);
+    if (progress.enabled())
+        estimateRays(scene, request, progress, r, [&](const RenderRequest& probe) { renderer.render(probe); });
+    const auto start = Clock::now();
+    renderer.render(request, &r.rays);
+    r.renderMs = msSince(start) - stream.blockedMs();
+    r.device = "CPU reference (double, " + std::to_string(std::max(1u, std::thread::hardware_concurrency())) +
+               " threads)";
+    return r;
+}
+
+RenderOutcome RenderCommand::renderOnGpu(const Scene& scene, RenderRequest& request, Progress& progress) const {
+    try {
+        RenderOutcome r;
+        vk::ContextOptions options;
+        options.deviceIndex = o_.device.gpu;
+        options.validation = o_.device.validation;
+        options.fault = faultInjection();
+        options.pipelineCachePath = pipelineCachePath();
+        vk::Context context(options);
+        ComputeRenderer renderer(context, scene, request.camera, o_.device.arithmetic());
+        if (const std::uint32_t budget = loopBudgetOverride()) renderer.forceLoopBudget(budget);
+        // The probe compiles the pipeline (the same one: same settings), which belongs to pipelineMs.
+        if (progress.enabled())
+            estimateRays(scene, request, progress, r, [&](const RenderRequest& probe) {
+                r.pipelineMs += renderer.render(probe, o_.stats).pipelineMs;
+            });
+        const GpuRenderResult g = renderer.render(request, o_.stats);
+        r.device = context.deviceName();
+        r.uploadMs = renderer.uploadMs();
+        r.rays = g.rays;
+        r.renderMs = g.renderMs;
+        r.pipelineMs += g.pipelineMs;
+        r.readbackMs = g.readbackMs;
+        r.tiles = g.tiles;
+        r.dispatches = g.dispatches;
+        r.timing = g.gpuTimed ? "gpu-timestamps" : "host";
+        if (g.stackOverflows > 0 && !o_.quiet)
+            std::cerr << "snell: warning: " << g.stackOverflows << " ray(s) found their invocation's ray stack ("
+                      << g.rayStack << " entries) full and were dropped (an amplifying tree); the truncation "
+                      << "bound includes them. A higher --min-weight or a lower --depth keeps the tree smaller\n";
+        if (o_.device.validation && context.validationMessages() > 0)
+            throw std::runtime_error("the Vulkan validation layer reported " +
+                                     std::to_string(context.validationMessages()) + " message(s)");
+        return r;
+    } catch (const vk::VulkanError&) {
+        if (interrupted()) throw Interrupted("no image written");
+        throw;
+    }
+}
+
+void RenderCommand::writeBoundImage(const RenderRequest& request, const std::vector<float>& bound) const {
+    // The bound as a grey image: float formats keep it as is.
+    const PixelWindow area = request.area();
+    Image image(area.width(), area.height());
+    for (std::size_t i = 0; i < bound.size(); ++i)
+        image.rgb[3 * i] = image.rgb[3 * i + 1] = image.rgb[3 * i + 2] = bound[i];
+    writeImage(o_.boundImage, image);
+}
+
+std::string RenderCommand::statsJson(const Scene& scene, const RenderRequest& request, const RenderOutcome& r,
+                                     const std::string& output, double parseMs, const OutputStream& stream,
+                                     double totalMs) const {
+    std::ostringstream j;
+    j.precision(6);
+    j << std::fixed << "{\"scene\": " << jsonString(o_.scene) << ", \"output\": " << jsonString(output)
+      << ", \"backend\": \"" << (o_.cpu ? "cpu" : "gpu") << "\", \"device\": " << jsonString(r.device)
+      << ", \"precision\": \"" << (o_.cpu ? "fp64-reference" : o_.device.precision) << "\""
+      << ", \"width\": " << request.width << ", \"height\": " << request.height
+      << ", \"supersample\": " << request.supersample << ", \"max_depth\": " << request.trace.maxDepth
+      << ", \"min_weight\": " << request.trace.minWeight << ", \"spheres\": " << scene.spheres.size()
+      << ", \"true_spheres\": " << scene.spheres.size() - scene.ellipsoidCount()
+      << ", \"ellipsoids\": " << scene.ellipsoidCount() << ", \"lights\": " << scene.lights.size()
+      << ", \"parse_ms\": " << parseMs << ", \"upload_ms\": " << r.uploadMs << ", \"pipeline_ms\": " << r.pipelineMs
+      << ", \"render_ms\": " << r.renderMs << ", \"render_timing\": \"" << r.timing << "\""
+      << ", \"tiles\": " << r.tiles << ", \"dispatches\": " << r.dispatches << ", \"readback_ms\": " << r.readbackMs
+      << ", \"write_ms\": " << stream.encodeMs() << ", \"write_wait_ms\": " << stream.blockedMs()
+      << ", \"total_ms\": " << totalMs
+      << ", \"rays\": {\"primary\": " << r.rays.primary << ", \"shadow\": " << r.rays.shadow
+      << ", \"reflected\": " << r.rays.reflected << ", \"refracted\": " << r.rays.refracted
+      << ", \"total\": " << r.rays.total() << "}"
+      << ", \"tolerance\": " << request.trace.tolerance << ", \"truncation\": " << truncationJson(truncation_)
+      << "}";
+    return j.str();
+}
+
+OutputStream::OutputStream(const std::string& path, const Scene& scene, const RenderOptions& o,
+                           const RenderRequest& request) {
+    const PixelWindow area = request.area();
+    const std::string settings =
+        "size " + std::to_string(request.width) + ", supersample " + std::to_string(request.supersample) +
+        ", depth " + std::to_string(request.trace.maxDepth) + ", min-weight " +
+        std::to_string(request.trace.minWeight) + ", " + (o.cpu ? "CPU reference" : "GPU " + o.device.precision);
+    ImageText text{{"Title", scene.name},
+                   {"Source", sceneFile(o.scene)},
+                   {"Software", std::string("snell ") + SNELL_VERSION},
+                   {"Comment", settings}};
+    // A piece of a larger image says where it goes (`snell assemble`).
+    if (!o.region.empty())
+        text.push_back({"Region", std::to_string(area.x0) + " " + std::to_string(area.y0) + " of " +
+                                      std::to_string(request.width) + "x" + std::to_string(request.height)});
+    // EXR keeps the window as its data window within the whole image.
+    const ImagePlacement placement{area.x0, area.y0, request.width, request.height};
+    // A few bands of rows may wait for the encoder: the render never waits
+    // for it unless the encoder is slower, and memory stays bounded.
+    constexpr int kQueuedRows = 1024;
+    writer_ = std::make_unique<BackgroundWriter>(ImageWriter::open(path, area.width(), area.height(), text, placement),
+                                                 area.width(), kQueuedRows);
+}
+
+std::function<void(const float*, int)> OutputStream::sink() {
+    return [this](const float* rgb, int rows) {
+        if (!error_.empty()) return;
+        try {
+            writer_->writeRows(rgb, rows);
+        } catch (const ImageIOError& e) {
+            error_ = e.what();
+        }
+    };
+}
+
+void OutputStream::commit() {
+    if (!error_.empty()) throw ImageIOError(error_);
+    writer_->commit();
+}
+
+}  // namespace
+
+std::unique_ptr<Command> makeRenderCommand() { return std::make_unique<RenderCommand>(); }
+
+}  // namespace snell::cli
