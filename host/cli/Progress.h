@@ -3,10 +3,12 @@
 // second, a few times a second; erased when the render ends.
 //
 // The time left: a render's cost is uneven over the image (sky above, glass
-// below), so extrapolating the pixels done misleads. Given the rays the whole
-// render will trace (estimated from a sparse render of the same image,
-// expectRays), the time left is the time so far scaled by the rays still to
-// trace; without it, by the pixels.
+// below), and within a region the cheap pixels finish first, so
+// extrapolating the pixels done misleads. Given the expected time of each
+// region in the order the renderer finishes them (from a sparse render of
+// the same image, expectCost), the time left is the unfinished regions'
+// expected time, scaled by how the finished ones compared with theirs, less
+// the time the current one has had. Without it, the pixels' pace.
 #pragma once
 
 #include <chrono>
@@ -14,6 +16,7 @@
 #include <functional>
 #include <mutex>
 #include <string>
+#include <vector>
 
 namespace snell::cli {
 
@@ -29,16 +32,22 @@ public:
     // Erases the bar (before any message that follows the render).
     void done();
     bool enabled() const { return enabled_; }
-    void expectRays(double total) { expectedRays_ = total; }
-    // The time left after `elapsed` seconds, `fraction` of the pixels and `rays` traced.
-    double secondsLeft(double elapsed, double fraction, std::uint64_t rays) const;
+    // The expected seconds of each region, in order; the render starts now.
+    void expectCost(std::vector<double> regions);
+    // The time left after `elapsed` seconds of rendering, with `fraction`
+    // (regions finished plus the current one's share, over their count)
+    // done. Also notes the regions finished.
+    double secondsLeft(double elapsed, double fraction);
 
 private:
     using Clock = std::chrono::steady_clock;
     void show(double fraction, std::uint64_t rays);
 
     bool enabled_;
-    double expectedRays_ = 0.0;
+    std::vector<double> cumulativeCost_;  // expected seconds before each region, and of all
+    std::size_t regionsDone_ = 0;
+    double secondsWhenDone_ = 0.0;       // the render's time when the last finished region ended
+    Clock::time_point renderStart_;
     bool shown_ = false;
     std::size_t width_ = 0;
     std::mutex mutex_;

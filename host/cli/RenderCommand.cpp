@@ -94,17 +94,20 @@ struct RenderOutcome {
     std::string device;
     std::string timing = "host";  // how renderMs was measured
     double uploadMs = 0, pipelineMs = 0, renderMs = 0, readbackMs = 0;
-    double estimateMs = 0;  // the progress bar's sparse render (estimateRays)
+    double estimateMs = 0;  // the progress bar's sparse render (estimateCost)
     int tiles = 0, dispatches = 0;
 };
 
-// For the progress bar's time left: the rays the render will trace, from a
-// render of one pixel in 256 (every 16th row and column of the same image,
-// so as uneven as it), costing about 1/256 of the render. Only for renders
-// long enough to show a bar for a while.
+// For the progress bar's time left: what each region of the image costs,
+// in the order the renderer finishes them, timed on a render of one pixel in
+// 256 (every 16th row and column of the same image), region by region,
+// costing about 1/256 of the render. Time rather than rays: a ray's cost
+// varies over the image (deep in a BVH, or through empty space). Only for
+// renders long enough to show a bar for a while. `render` returns its
+// milliseconds.
 template <class Render>
-void estimateRays(const Scene& scene, const RenderRequest& request, Progress& progress, RenderOutcome& outcome,
-                  Render render) {
+void estimateCost(const Scene& scene, const RenderRequest& request, const std::vector<PixelWindow>& regions,
+                  Progress& progress, RenderOutcome& outcome, Render render) {
     constexpr int kStride = 16;
     constexpr double kMinCameraRays = 1 << 22;
     const PixelWindow area = request.area();
@@ -113,23 +116,30 @@ void estimateRays(const Scene& scene, const RenderRequest& request, Progress& pr
     RenderRequest probe;
     probe.width = probe.height = std::max(1, request.width / kStride);
     probe.camera = Camera::fromSpec(probe.width, scene.halfWidth);
-    probe.window = {area.x0 / kStride, area.y0 / kStride, std::max(area.x1 / kStride, area.x0 / kStride + 1),
-                    std::max(area.y1 / kStride, area.y0 / kStride + 1)};
     probe.supersample = request.supersample;
     probe.trace = request.trace;
     probe.cancel = request.cancel;
-    // The CPU reports from its worker threads: keep the largest count seen.
-    std::atomic<std::uint64_t> rays{0};
-    probe.progress = [&rays](double, std::uint64_t traced) {
-        for (std::uint64_t seen = rays.load(); seen < traced && !rays.compare_exchange_weak(seen, traced);) {
-        }
-    };
     const auto start = Clock::now();
-    render(probe);
+    std::vector<double> seconds;
+    for (const PixelWindow& r : regions) {
+        const int x0 = std::min(r.x0 / kStride, probe.width - 1), y0 = std::min(r.y0 / kStride, probe.height - 1);
+        probe.window = {x0, y0, std::max(r.x1 / kStride, x0 + 1), std::max(r.y1 / kStride, y0 + 1)};
+        // In the render's own time: the probe saw one pixel in (its share of) the region's.
+        const PixelWindow seen = probe.area();
+        seconds.push_back(1e-3 * render(probe) * double(r.width()) * r.height() / (double(seen.width()) * seen.height()));
+    }
     outcome.estimateMs = msSince(start);
-    const PixelWindow sampled = probe.area();
-    progress.expectRays(double(rays.load()) * double(area.width()) * area.height() /
-                        (double(sampled.width()) * sampled.height()));
+    progress.expectCost(std::move(seconds));
+}
+
+// The CPU reference finishes rows top to bottom: its regions are bands of rows.
+std::vector<PixelWindow> rowBands(const PixelWindow& area) {
+    constexpr int kBands = 32;
+    std::vector<PixelWindow> bands;
+    const int count = std::min(kBands, area.height());
+    for (int b = 0; b < count; ++b)
+        bands.push_back({area.x0, area.y0 + area.height() * b / count, area.x1, area.y0 + area.height() * (b + 1) / count});
+    return bands;
 }
 
 // The image streams to a temporary file beside the output as bands of rows
@@ -141,11 +151,14 @@ public:
     // The RenderRequest's row sink; keeps the first error for commit().
     std::function<void(const float*, int)> sink();
     void commit();
+    // Encode beside the render, where that is faster (see BackgroundWriter).
+    void encodeBeside(bool cpuRenderer);
     double encodeMs() const { return writer_->encodeMs(); }    // spent encoding, mostly during the render
     double blockedMs() const { return writer_->blockedMs(); }  // the render's wait for it, and the wait after it
 
 private:
     std::unique_ptr<BackgroundWriter> writer_;
+    ImageFormat format_;
     std::string error_;
 };
 
@@ -158,9 +171,10 @@ private:
     RenderRequest makeRequest(const Scene& scene) const;
     TraceSettings traceSettings() const;
     void refuseRunawayTrees(const Scene& scene, const TraceSettings& trace) const;
-    RenderOutcome renderOnCpu(const Scene& scene, RenderRequest& request, const OutputStream& stream,
+    RenderOutcome renderOnCpu(const Scene& scene, RenderRequest& request, OutputStream& stream,
                               Progress& progress) const;
-    RenderOutcome renderOnGpu(const Scene& scene, RenderRequest& request, Progress& progress) const;
+    RenderOutcome renderOnGpu(const Scene& scene, RenderRequest& request, OutputStream& stream,
+                              Progress& progress) const;
     void writeBoundImage(const RenderRequest& request, const std::vector<float>& bound) const;
     std::string statsJson(const Scene& scene, const RenderRequest& request, const RenderOutcome& r,
                           const std::string& output, double parseMs, const OutputStream& stream, double totalMs) const;
@@ -234,7 +248,7 @@ int RenderCommand::run() {
     request.rowSink = stream.sink();
 
     const RenderOutcome outcome =
-        o_.cpu ? renderOnCpu(scene, request, stream, progress) : renderOnGpu(scene, request, progress);
+        o_.cpu ? renderOnCpu(scene, request, stream, progress) : renderOnGpu(scene, request, stream, progress);
     progress.done();
     if (interrupted()) throw Interrupted("no image written");
     stream.commit();
@@ -313,12 +327,17 @@ void RenderCommand::refuseRunawayTrees(const Scene& scene, const TraceSettings& 
     throw ParseError(Diagnostic{{sceneFile(o_.scene), at.line, at.column}, m.str()});
 }
 
-RenderOutcome RenderCommand::renderOnCpu(const Scene& scene, RenderRequest& request, const OutputStream& stream,
+RenderOutcome RenderCommand::renderOnCpu(const Scene& scene, RenderRequest& request, OutputStream& stream,
                                          Progress& progress) const {
     RenderOutcome r;
     CpuRenderer renderer(scene);
+    stream.encodeBeside(true);
     if (progress.enabled())
-        estimateRays(scene, request, progress, r, [&](const RenderRequest& probe) { renderer.render(probe); });
+        estimateCost(scene, request, rowBands(request.area()), progress, r, [&](const RenderRequest& probe) {
+            const auto start = Clock::now();
+            renderer.render(probe);
+            return msSince(start);
+        });
     const auto start = Clock::now();
     renderer.render(request, &r.rays);
     r.renderMs = msSince(start) - stream.blockedMs();
@@ -327,7 +346,8 @@ RenderOutcome RenderCommand::renderOnCpu(const Scene& scene, RenderRequest& requ
     return r;
 }
 
-RenderOutcome RenderCommand::renderOnGpu(const Scene& scene, RenderRequest& request, Progress& progress) const {
+RenderOutcome RenderCommand::renderOnGpu(const Scene& scene, RenderRequest& request, OutputStream& stream,
+                                         Progress& progress) const {
     try {
         RenderOutcome r;
         vk::ContextOptions options;
@@ -336,13 +356,17 @@ RenderOutcome RenderCommand::renderOnGpu(const Scene& scene, RenderRequest& requ
         options.fault = faultInjection();
         options.pipelineCachePath = pipelineCachePath();
         vk::Context context(options);
+        stream.encodeBeside(context.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU);
         ComputeRenderer renderer(context, scene, request.camera, o_.device.arithmetic());
         if (const std::uint32_t budget = loopBudgetOverride()) renderer.forceLoopBudget(budget);
         // The probe compiles the pipeline (the same one: same settings), which belongs to pipelineMs.
         if (progress.enabled())
-            estimateRays(scene, request, progress, r, [&](const RenderRequest& probe) {
-                r.pipelineMs += renderer.render(probe, o_.stats).pipelineMs;
-            });
+            estimateCost(scene, request, ComputeRenderer::tiles(request.area()), progress, r,
+                         [&](const RenderRequest& probe) {
+                             const GpuRenderResult g = renderer.render(probe, o_.stats);
+                             r.pipelineMs += g.pipelineMs;
+                             return g.renderMs;
+                         });
         const GpuRenderResult g = renderer.render(request, o_.stats);
         r.device = context.deviceName();
         r.uploadMs = renderer.uploadMs();
@@ -422,6 +446,7 @@ OutputStream::OutputStream(const std::string& path, const Scene& scene, const Re
     // A few bands of rows may wait for the encoder: the render never waits
     // for it unless the encoder is slower, and memory stays bounded.
     constexpr int kQueuedRows = 1024;
+    format_ = formatForPath(path);
     writer_ = std::make_unique<BackgroundWriter>(ImageWriter::open(path, area.width(), area.height(), text, placement),
                                                  area.width(), kQueuedRows);
 }
@@ -435,6 +460,13 @@ std::function<void(const float*, int)> OutputStream::sink() {
             error_ = e.what();
         }
     };
+}
+
+void OutputStream::encodeBeside(bool cpuRenderer) {
+    // Measured on lavapipe (2 cores): a thread that encodes EXR beside the
+    // render saves more than it slows the render; one that encodes PNG slows
+    // it more than it saves. A GPU leaves the cores to the encoder.
+    if (!cpuRenderer || format_ == ImageFormat::Exr) writer_->start();
 }
 
 void OutputStream::commit() {

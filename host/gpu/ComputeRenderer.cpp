@@ -339,13 +339,20 @@ void memoryBarrier(VkCommandBuffer cmd, VkAccessFlags srcAccess, VkAccessFlags d
 
 // Device memory for the invocations' ray stacks.
 constexpr VkDeviceSize kStackBudget = 64ull << 20;
-// The largest tile side: an image is rendered (and streamed) tile by tile.
-constexpr int kMaxTileSide = 1024;
 // Workgroups of persistent invocations per core on a CPU device (lavapipe):
 // enough that the cores finish together.
 constexpr unsigned kCpuWorkgroupsPerCore = 8;
 
 }  // namespace
+
+std::vector<PixelWindow> ComputeRenderer::tiles(const PixelWindow& area) {
+    const int tileW = std::min(kMaxTileSide, area.width()), tileH = std::min(kMaxTileSide, area.height());
+    std::vector<PixelWindow> out;
+    for (int y = area.y0; y < area.y1; y += tileH)
+        for (int x = area.x0; x < area.x1; x += tileW)
+            out.push_back({x, y, std::min(x + tileW, area.x1), std::min(y + tileH, area.y1)});
+    return out;
+}
 
 GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool countRays) {
     GpuRenderResult result;

@@ -46,6 +46,13 @@ public:
     // buffers are kept for the next render, which reuses them when it can.
     GpuRenderResult render(const RenderRequest& request, bool countRays);
 
+    // The largest tile side: an image is rendered (and streamed) tile by tile.
+    static constexpr int kMaxTileSide = 1024;
+    // The tiles render() traces `area` in, in that order (row by row of
+    // tiles); its progress fraction counts finished tiles plus the share of
+    // the current tile's pixels finished, over the tile count.
+    static std::vector<PixelWindow> tiles(const PixelWindow& area);
+
     // Testing: suspend and resume the invocations every `budget` loop
     // iterations (SNELL_LOOP_BUDGET), as on a driver that limits loops,
     // whatever this driver does. The image must not change.

@@ -13,8 +13,11 @@ double msSince(Clock::time_point start) {
 }  // namespace
 
 BackgroundWriter::BackgroundWriter(std::unique_ptr<ImageWriter> writer, int width, int maxQueuedRows)
-    : writer_(std::move(writer)), width_(width), maxQueuedRows_(std::max(1, maxQueuedRows)),
-      thread_([this] { run(); }) {}
+    : writer_(std::move(writer)), width_(width), maxQueuedRows_(std::max(1, maxQueuedRows)) {}
+
+void BackgroundWriter::start() {
+    if (!thread_.joinable()) thread_ = std::thread([this] { run(); });
+}
 
 BackgroundWriter::~BackgroundWriter() {
     {
@@ -26,6 +29,13 @@ BackgroundWriter::~BackgroundWriter() {
 }
 
 void BackgroundWriter::writeRows(const float* rgb, int rows) {
+    if (!thread_.joinable()) {
+        const auto start = Clock::now();
+        writer_->writeRows(rgb, rows);
+        encodeMs_ += msSince(start);
+        blockedMs_ += msSince(start);
+        return;
+    }
     std::vector<float> band(rgb, rgb + std::size_t(rows) * width_ * 3);
     const auto start = Clock::now();
     std::unique_lock<std::mutex> lock(mutex_);
@@ -47,7 +57,7 @@ void BackgroundWriter::commit() {
         closing_ = true;
     }
     changed_.notify_all();
-    thread_.join();
+    if (thread_.joinable()) thread_.join();
     if (!error_.empty()) throw ImageIOError(error_);
     const auto finish = Clock::now();
     writer_->commit();  // the last of the encoding (EXR's offset table, PNG's end)

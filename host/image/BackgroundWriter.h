@@ -1,6 +1,8 @@
-// An ImageWriter on a thread of its own: encoding and compressing the rows
-// (PNG's deflate, EXR's PIZ) overlap the render that produces them, instead
-// of following it.
+// An ImageWriter that may encode on a thread of its own: then compressing
+// the rows (PNG's deflate, EXR's PIZ) overlaps the render that produces them
+// instead of following it. Worth it only where the render leaves a core free
+// or the encoding is dear (docs/performance.md, "Writing images"); until
+// start() the rows are written at once, on the caller's thread.
 #pragma once
 
 #include <condition_variable>
@@ -19,6 +21,8 @@ public:
     // Rows wait in a queue of at most `maxQueuedRows` rows (the producer
     // blocks beyond it, so memory stays bounded).
     BackgroundWriter(std::unique_ptr<ImageWriter> writer, int width, int maxQueuedRows);
+    // Encodes on a thread from now on (before the first row).
+    void start();
     // Without commit() the file is discarded (ImageWriter's rule).
     ~BackgroundWriter();
     BackgroundWriter(const BackgroundWriter&) = delete;
