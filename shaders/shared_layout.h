@@ -76,7 +76,8 @@ using uint = std::uint32_t;
 #define SNELL_SPEC_ELLIPSOID_MASK 13
 #define SNELL_SPEC_SPHERES_IN_BLOCK 14
 #define SNELL_SPEC_FRONTIER 15
-#define SNELL_SPEC_COUNT 16
+#define SNELL_SPEC_COUNT_LANES 16  // count the SIMD lanes busy in each loop pass (render --count-lanes)
+#define SNELL_SPEC_COUNT 17
 
 // Slots of the counters buffer: rays by kind, then per-dispatch bookkeeping.
 #define SNELL_COUNTER_PRIMARY 0
@@ -89,7 +90,14 @@ using uint = std::uint32_t;
 #define SNELL_COUNTER_DEEPEST 6     // the deepest ray traced (atomicMax)
 #define SNELL_COUNTER_OVERFLOW 7    // rays dropped because an invocation's ray stack was full
 #define SNELL_COUNTER_CANCEL 8      // set by the host while a dispatch runs: take no new pixel
-#define SNELL_COUNTER_COUNT 9
+// With COUNT_LANES: lane slots (subgroup size per pass of a subgroup) and
+// lanes busy in them, of the trace loop (a lane busy: it traces a ray) and of
+// the BVH walk (a lane busy: it walks).
+#define SNELL_COUNTER_TRACE_SLOTS 9
+#define SNELL_COUNTER_TRACE_BUSY 10
+#define SNELL_COUNTER_WALK_SLOTS 11
+#define SNELL_COUNTER_WALK_BUSY 12
+#define SNELL_COUNTER_COUNT 13
 
 // Mesa's llvmpipe before 24 (lavapipe in Debian 12's Mesa 22.3) ends every
 // loop of a shader once one SIMD row has run 65535 loop iterations in total in

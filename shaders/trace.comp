@@ -42,6 +42,20 @@ layout(constant_id = SNELL_SPEC_HAS_REFRACTION) const bool HAS_REFRACTION = true
 layout(constant_id = SNELL_SPEC_HAS_REFLECTION) const bool HAS_REFLECTION = true;
 layout(constant_id = SNELL_SPEC_HAS_LIGHTS) const bool HAS_LIGHTS = true;
 layout(constant_id = SNELL_SPEC_COUNT_RAYS) const bool COUNT_RAYS = false;
+// Measuring the kernel: how many of a subgroup's lanes do useful work in each
+// pass of the trace loop and of the BVH walk (lanes that left a loop, or
+// have nothing to trace, idle while the others go on).
+layout(constant_id = SNELL_SPEC_COUNT_LANES) const bool COUNT_LANES = false;
+uint traceSlots = 0u, traceBusy = 0u, walkSlots = 0u, walkBusy = 0u;  // this invocation's share
+
+// Counts a pass of the subgroup's active lanes: subgroup-size slots, `busy` of them used.
+void countLanes(bool busy, inout uint slots, inout uint used) {
+    uint n = subgroupAdd(busy ? 1u : 0u);
+    if (subgroupElect()) {
+        slots += gl_SubgroupSize;
+        used += n;
+    }
+}
 layout(constant_id = SNELL_SPEC_MAX_MEDIA) const int MAX_MEDIA = 1;
 layout(constant_id = SNELL_SPEC_RAY_STACK) const uint RAY_STACK = 1u;
 layout(constant_id = SNELL_SPEC_AMPLIFYING) const bool AMPLIFYING = false;
@@ -193,6 +207,7 @@ uint traverseBvh(rvec3 origin, real originLength, rvec3 dir, uint fromSphere, ui
     uint depth = 0u;          // entries on the stack
     while (true) {
         tick(1u);
+        if (COUNT_LANES) countLanes(true, walkSlots, walkBusy);
         if (code != SNELL_BVH_INNER) {
             // A leaf: spheres first · 4 + count − 1 = code.
             uint first = code >> 2;
@@ -776,6 +791,7 @@ void main() {
             }
         }
 
+        if (COUNT_LANES) countLanes(hasRay, traceSlots, traceBusy);
         // Trace the ray in hand: closest hit, local term, children.
         vec3 weight = vec3(0.0);
         Hit h;
@@ -852,6 +868,12 @@ void main() {
     if (COUNT_RAYS) {
         [[unroll]] for (int k = 0; k < SNELL_RAY_COUNTER_COUNT; ++k)
             if (countedRays[k] != 0u) atomicAdd(counters[k], countedRays[k]);
+    }
+    if (COUNT_LANES) {
+        if (traceSlots != 0u) atomicAdd(counters[SNELL_COUNTER_TRACE_SLOTS], traceSlots);
+        if (traceBusy != 0u) atomicAdd(counters[SNELL_COUNTER_TRACE_BUSY], traceBusy);
+        if (walkSlots != 0u) atomicAdd(counters[SNELL_COUNTER_WALK_SLOTS], walkSlots);
+        if (walkBusy != 0u) atomicAdd(counters[SNELL_COUNTER_WALK_BUSY], walkBusy);
     }
     // Past the driver's limit some loop may have been cut short: say so.
     if (LOOP_BUDGET != 0u) {

@@ -244,5 +244,17 @@ printf 'view 8192 1\nlight 1 1 1 0 0 5\nmove 0 0 -3\nsphere\n' >"$work/big.scn"
 "$SNELL" render "$work/big.scn" --size 64 -o "$work/big.png" 2>"$work/err" && [ ! -s "$work/err" ] && ok || bad "warned at a small size: $(cat "$work/err")"
 "$SNELL" render "$SCENES/basic.scn" --size 24 -o "$work/x.png" 2>"$work/err" && [ ! -s "$work/err" ] && ok || bad "warnings on a plain scene: $(cat "$work/err")"
 
+# --count-lanes measures the kernel without changing the image: shares of busy
+# lanes in [0, 1], a BVH walk counted only where there is a BVH.
+"$SNELL" render "$SCENES/grid.scn" --size 32 -q -o "$work/lanes.png" --count-lanes --stats >"$work/stats" &&
+  "$SNELL" render "$SCENES/grid.scn" --size 32 -q -o "$work/nolanes.png" &&
+  "$SNELL" compare "$work/lanes.png" "$work/nolanes.png" --max-mean 0 --max-bad 0 >/dev/null &&
+  python3 - "$work/stats" <<'PY' && ok || bad "--count-lanes: $(tail -n 1 "$work/stats")"
+import json, sys
+lanes = json.loads(open(sys.argv[1]).read().splitlines()[-1])["lanes"]
+assert 0 < lanes["trace_busy"] <= lanes["trace_slots"] and 0 < lanes["trace_occupancy"] <= 1, lanes
+assert 0 < lanes["walk_busy"] <= lanes["walk_slots"] and 0 < lanes["walk_occupancy"] <= 1, lanes
+PY
+
 echo "cli: $pass passed, $fail failed"
 [ $fail -eq 0 ]

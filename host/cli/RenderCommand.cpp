@@ -48,6 +48,7 @@ struct RenderOptions {
     bool stats = false;
     bool quiet = false;
     bool verbose = false;
+    bool countLanes = false;
 };
 
 // Where the render may still differ from the exact image (SPEC §4 limit):
@@ -88,6 +89,8 @@ std::string truncationJson(const TruncationReport& t) {
     return j.str();
 }
 
+double share(std::uint64_t part, std::uint64_t whole) { return whole ? double(part) / double(whole) : 0.0; }
+
 // What the renderer did, for --verbose and --stats.
 struct RenderOutcome {
     RayCounts rays;
@@ -96,6 +99,7 @@ struct RenderOutcome {
     double uploadMs = 0, pipelineMs = 0, renderMs = 0, readbackMs = 0;
     double estimateMs = 0;  // the progress bar's sparse render (estimateCost)
     int tiles = 0, dispatches = 0;
+    GpuRenderResult::Lanes lanes;
 };
 
 // For the progress bar's time left: what each region of the image costs,
@@ -223,6 +227,9 @@ CLI::App* RenderCommand::define(CLI::App& app) {
                 "Print timings and ray counts as one JSON object on the last line of stdout (stderr with -o -)");
     c->add_flag("-q,--quiet", o_.quiet, "No warnings or progress on stderr");
     c->add_flag("-v,--verbose", o_.verbose, "Say on stderr which device rendered and where the time went");
+    c->add_flag("--count-lanes", o_.countLanes,
+                "Measure the kernel: count the SIMD lanes busy in each pass of the trace loop and of the BVH walk "
+                "(slower; --stats and -v report them)");
     return c;
 }
 
@@ -266,6 +273,12 @@ int RenderCommand::run() {
                      outcome.dispatches, outcome.readbackMs, stream.encodeMs(), stream.blockedMs(),
                      outcome.estimateMs > 0 ? (", estimate " + std::to_string(int(outcome.estimateMs)) + " ms").c_str() : "",
                      msSince(totalStart));
+    if (o_.verbose && o_.countLanes && !o_.cpu)
+        std::fprintf(stderr, "snell: lanes busy: trace loop %.1f %% of %llu slots, BVH walk %.1f %% of %llu\n",
+                     100.0 * share(outcome.lanes.traceBusy, outcome.lanes.traceSlots),
+                     static_cast<unsigned long long>(outcome.lanes.traceSlots),
+                     100.0 * share(outcome.lanes.walkBusy, outcome.lanes.walkSlots),
+                     static_cast<unsigned long long>(outcome.lanes.walkSlots));
     if (o_.stats) {
         // With the image on standard output, the statistics go to standard error.
         std::ostream& out = output == kStandardOutput ? std::cerr : std::cout;
@@ -359,6 +372,7 @@ RenderOutcome RenderCommand::renderOnGpu(const Scene& scene, RenderRequest& requ
         stream.encodeBeside(context.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU);
         ComputeRenderer renderer(context, scene, request.camera, o_.device.arithmetic());
         if (const std::uint32_t budget = loopBudgetOverride()) renderer.forceLoopBudget(budget);
+        renderer.countLanes(o_.countLanes);
         // The probe compiles the pipeline (the same one: same settings), which belongs to pipelineMs.
         if (progress.enabled())
             estimateCost(scene, request, ComputeRenderer::tiles(request.area()), progress, r,
@@ -376,6 +390,7 @@ RenderOutcome RenderCommand::renderOnGpu(const Scene& scene, RenderRequest& requ
         r.readbackMs = g.readbackMs;
         r.tiles = g.tiles;
         r.dispatches = g.dispatches;
+        r.lanes = g.lanes;
         r.timing = g.gpuTimed ? "gpu-timestamps" : "host";
         if (g.stackOverflows > 0 && !o_.quiet)
             std::cerr << "snell: warning: " << g.stackOverflows << " ray(s) found their invocation's ray stack ("
@@ -421,8 +436,13 @@ std::string RenderCommand::statsJson(const Scene& scene, const RenderRequest& re
       << ", \"rays\": {\"primary\": " << r.rays.primary << ", \"shadow\": " << r.rays.shadow
       << ", \"reflected\": " << r.rays.reflected << ", \"refracted\": " << r.rays.refracted
       << ", \"total\": " << r.rays.total() << "}"
-      << ", \"tolerance\": " << request.trace.tolerance << ", \"truncation\": " << truncationJson(truncation_)
-      << "}";
+      << ", \"tolerance\": " << request.trace.tolerance << ", \"truncation\": " << truncationJson(truncation_);
+    if (o_.countLanes && !o_.cpu)
+        j << ", \"lanes\": {\"trace_slots\": " << r.lanes.traceSlots << ", \"trace_busy\": " << r.lanes.traceBusy
+          << ", \"trace_occupancy\": " << share(r.lanes.traceBusy, r.lanes.traceSlots)
+          << ", \"walk_slots\": " << r.lanes.walkSlots << ", \"walk_busy\": " << r.lanes.walkBusy
+          << ", \"walk_occupancy\": " << share(r.lanes.walkBusy, r.lanes.walkSlots) << "}";
+    j << "}";
     return j.str();
 }
 

@@ -214,6 +214,7 @@ ComputeRenderer::Specialisation ComputeRenderer::specialise(const RenderRequest&
             ? (context_.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU ? kCpuFrontier : kGpuFrontier)
             : 0u;
     values[SNELL_SPEC_LOOP_BUDGET] = loopBudget_;
+    values[SNELL_SPEC_COUNT_LANES] = countLanes_;
     return values;
 }
 
@@ -581,6 +582,12 @@ GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool count
                                               "lights or a smaller --depth");
                     truncation.deepest = std::max(truncation.deepest, int(counters[SNELL_COUNTER_DEEPEST]));
                     result.stackOverflows += counters[SNELL_COUNTER_OVERFLOW];
+                    if (countLanes_) {
+                        result.lanes.traceSlots += counters[SNELL_COUNTER_TRACE_SLOTS];
+                        result.lanes.traceBusy += counters[SNELL_COUNTER_TRACE_BUSY];
+                        result.lanes.walkSlots += counters[SNELL_COUNTER_WALK_SLOTS];
+                        result.lanes.walkBusy += counters[SNELL_COUNTER_WALK_BUSY];
+                    }
                     if (countRays) {
                         result.rays.primary += counters[SNELL_COUNTER_PRIMARY];
                         result.rays.shadow += counters[SNELL_COUNTER_SHADOW];

@@ -26,6 +26,11 @@ struct GpuRenderResult {
     int invocations = 0;      // persistent invocations a dispatch (trace.comp)
     std::uint32_t rayStack = 0;        // entries of each invocation's ray stack
     std::uint64_t stackOverflows = 0;  // rays dropped on a full stack (their weight is in the bound)
+    // With countLanes(true): SIMD lane slots (a subgroup's size, each pass it
+    // makes) and the lanes busy in them, of the trace loop and of the BVH walk.
+    struct Lanes {
+        std::uint64_t traceSlots = 0, traceBusy = 0, walkSlots = 0, walkBusy = 0;
+    } lanes;
 };
 
 class ComputeRenderer {
@@ -57,6 +62,8 @@ public:
     // iterations (SNELL_LOOP_BUDGET), as on a driver that limits loops,
     // whatever this driver does. The image must not change.
     void forceLoopBudget(std::uint32_t budget) { loopBudget_ = budget; }
+    // Measuring: count the lanes busy in each loop pass (GpuRenderResult::lanes; slower).
+    void countLanes(bool count) { countLanes_ = count; }
 
 private:
     struct Pipeline;
@@ -75,6 +82,7 @@ private:
     std::array<vk::Buffer, SNELL_BINDING_COUNT> sceneBuffers_{};
     std::array<VkBufferView, SNELL_BINDING_COUNT> sceneViews_{};
     std::uint32_t loopBudget_ = 0;  // where the driver ends long loops (gpu/DriverProbe.h), else 0
+    bool countLanes_ = false;
     double uploadMs_ = 0.0;
     std::unique_ptr<Pipeline> cached_;  // the last render's, reused by the next when it fits
 };
