@@ -243,6 +243,13 @@ printf 'view 8192 1\nlight 1 1 1 0 0 5\nmove 0 0 -3\nsphere\n' >"$work/big.scn"
   ok || bad "no warning of an expensive render: $(cat "$work/err")"
 "$SNELL" render "$work/big.scn" --size 64 -o "$work/big.png" 2>"$work/err" && [ ! -s "$work/err" ] && ok || bad "warned at a small size: $(cat "$work/err")"
 "$SNELL" render "$SCENES/basic.scn" --size 24 -o "$work/x.png" 2>"$work/err" && [ ! -s "$work/err" ] && ok || bad "warnings on a plain scene: $(cat "$work/err")"
+# Amplifying materials at the defaults, on a large image: the cost and the
+# cheaper fixed tree are named; asking for a tree silences it.
+"$SNELL" render "$SCENES/glass.scn" --size 4096 --region 0 0 1 1 -o "$work/x.png" 2>"$work/err" &&
+  grep -q "glass.scn: warning: at the defaults this render may trace up to .* --depth 5 --min-weight 0" "$work/err" && ok ||
+  bad "no warning of an expensive amplifying render: $(cat "$work/err")"
+"$SNELL" render "$SCENES/glass.scn" --size 4096 --depth 5 --region 0 0 1 1 -o "$work/x.png" 2>"$work/err" &&
+  ! grep -q "at the defaults" "$work/err" && ok || bad "the defaults' warning with a fixed tree: $(cat "$work/err")"
 
 # --count-lanes measures the kernel without changing the image: shares of busy
 # lanes in [0, 1], a BVH walk counted only where there is a BVH.

@@ -23,13 +23,15 @@ struct SceneReport {
 struct RenderShape {
     int size = 0;
     int supersample = 1;
+    bool defaultTree = true;  // the default trace settings (no --depth, --min-weight, --tolerance)
 };
 
 // What looks wrong in a scene, the same for `check` and `render` (one set of
 // warnings, one set of thresholds), each saying what to do: the parser's;
 // lights inside spheres; spheres behind the camera; a scene that can only
-// render the background or black; a render whose size alone makes it
-// expensive. `path`: the scene's file, for the warnings' locations.
+// render the background or black; a render whose size makes it expensive,
+// or whose amplifying materials do at the defaults (measured on a few
+// pixels with the CPU reference). `path`: the scene's file, for the warnings' locations.
 std::vector<Diagnostic> sceneWarnings(const Scene& scene, const std::string& path, RenderShape shape);
 
 // The report of `snell check`: warnings at the scene's own size.

@@ -67,8 +67,9 @@ void printTruncationWarnings(const TruncationReport& t, const TraceSettings& set
     if (t.unbounded > t.estimated)
         std::cerr << "snell: warning: " << t.unbounded - t.estimated
                   << " pixel(s) dropped light of a material with ks + kt >= 1, which need not decay, and their "
-                  << "colour had not settled at the floor cut-off: their bound is only the clamp to 1 "
-                  << "(--bound-image shows it)" << examples(t.unboundedExamples, t.unbounded) << "\n";
+                  << "colour had not settled at the floor cut-off " << settings.minWeight
+                  << ": the image is not certified there (--bound-image shows where); a lower --min-weight "
+                  << "traces them further" << examples(t.unboundedExamples, t.unbounded) << "\n";
     if (t.overBudget > 0)
         std::cerr << "snell: warning: " << t.overBudget << " pixel(s) reached the tree budget of "
                   << settings.treeBudget << " rays a sample and were stopped (their bound says by how much they "
@@ -174,6 +175,10 @@ public:
 private:
     RenderRequest makeRequest(const Scene& scene) const;
     TraceSettings traceSettings() const;
+    // The GPU's default ray trees: no tree asked for on the command line.
+    bool defaultTree() const {
+        return !o_.cpu && !o_.tree.depth && !o_.tree.minWeight && !o_.tolerance && !o_.treeBudget;
+    }
     void refuseRunawayTrees(const Scene& scene, const TraceSettings& trace) const;
     RenderOutcome renderOnCpu(const Scene& scene, RenderRequest& request, OutputStream& stream,
                               Progress& progress) const;
@@ -240,7 +245,7 @@ int RenderCommand::run() {
     const double parseMs = msSince(parseStart);
     RenderRequest request = makeRequest(scene);
     if (!o_.quiet)
-        for (const Diagnostic& w : sceneWarnings(scene, sceneFile(o_.scene), {request.width, request.supersample}))
+        for (const Diagnostic& w : sceneWarnings(scene, sceneFile(o_.scene), {request.width, request.supersample, defaultTree()}))
             std::cerr << w.format("warning") << "\n";
 
     const std::string output = o_.output.empty() ? scene.name + ".png" : o_.output;
