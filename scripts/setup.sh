@@ -3,7 +3,7 @@
 # Used by both quick-start commands; safe to run again.
 #
 # lavapipe (Mesa's CPU Vulkan driver) comes from bookworm-backports, Mesa 25:
-# measured 2-5x faster on snell's shader than Debian 12's own Mesa 22.3
+# measured 1.5-3.4x as fast on snell's shader as Debian 12's own Mesa 22.3
 # (docs/performance.md). SNELL_LAVAPIPE=stock keeps the stock driver. Either
 # way the other one is unpacked beside the build (build/lavapipe-*/, used
 # through VK_DRIVER_FILES, the system's untouched) so the tests run on both.
@@ -30,13 +30,35 @@ if [ ${#missing[@]} -gt 0 ]; then
 fi
 
 # --- lavapipe: Mesa 25 from bookworm-backports by default. ------------------
+# The URI of the first enabled source of the bookworm suite itself, in
+# one-line (sources.list) or deb822 (.sources) form; Debian's default if none.
+debian_mirror() {
+  local uri
+  uri=$(cat /etc/apt/sources.list /etc/apt/sources.list.d/*.list 2>/dev/null |
+        awk '$1 == "deb" { for (i = 2; i <= NF; i++) if ($i !~ /^\[/ && $i !~ /\]$/) break;
+                           if ($(i + 1) == "bookworm") { print $i; exit } }')
+  if [ -z "$uri" ]; then
+    uri=$(cat /etc/apt/sources.list.d/*.sources 2>/dev/null |
+          awk 'BEGIN { RS = ""; FS = "\n" }
+               { uris = ""; suites = ""; enabled = 1
+                 for (i = 1; i <= NF; i++) {
+                   if ($i ~ /^URIs:/) { uris = $i; sub(/^URIs:[ \t]*/, "", uris) }
+                   if ($i ~ /^Suites:/) { suites = " " $i " "; sub(/^ Suites:/, "", suites) }
+                   if ($i ~ /^Enabled:[ \t]*no/) enabled = 0 }
+                 if (enabled && suites ~ /[ \t]bookworm[ \t]/) { split(uris, u, /[ \t]+/); print u[1]; exit } }')
+  fi
+  echo "${uri:-http://deb.debian.org/debian}"
+}
 mesa_version() { dpkg-query -W -f='${Version}' mesa-vulkan-drivers 2>/dev/null; }
 second_icd=""
 codename=$(. /etc/os-release 2>/dev/null && echo "${VERSION_CODENAME:-}")
 if [ "$codename" = bookworm ]; then
   if ! grep -rqs "bookworm-backports" /etc/apt/sources.list /etc/apt/sources.list.d/; then
-    echo "snell setup: adding Debian's bookworm-backports to apt's sources (for Mesa 25's lavapipe)" >&2
-    printf 'Types: deb\nURIs: http://deb.debian.org/debian\nSuites: bookworm-backports\nComponents: main\nSigned-By: /usr/share/keyrings/debian-archive-keyring.gpg\n' |
+    # The mirror the machine already takes bookworm from (a machine behind a
+    # local mirror or proxy may reach no other), else Debian's own.
+    mirror=$(debian_mirror)
+    echo "snell setup: adding bookworm-backports from $mirror to apt's sources (for Mesa 25's lavapipe)" >&2
+    printf 'Types: deb\nURIs: %s\nSuites: bookworm-backports\nComponents: main\nSigned-By: /usr/share/keyrings/debian-archive-keyring.gpg\n' "$mirror" |
       $SUDO tee /etc/apt/sources.list.d/snell-bookworm-backports.sources >/dev/null
     apt_updated=""
   fi

@@ -1,6 +1,6 @@
 // snell's renderer: SPEC §3–§5 in float32, or in double when compiled with
 // SNELL_FP64 (precision.glsl; --precision fp64).
-// The path of one ray: camera (nextRay) -> closestHit / intersectSphere ->
+// The path of one ray: camera (cameraRay) -> closestHit / intersectSphere ->
 // shade (local Phong term, shadow rays) -> children pushed on the explicit
 // stack (spawnChildren). Its double-precision twin is
 // host/reference/CpuRenderer.cpp; the intersection maths is explained in

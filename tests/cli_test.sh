@@ -163,8 +163,9 @@ if command -v script >/dev/null; then
   script -qfec "$SNELL render $SCENES/basic.scn --size 2048 -v -o $work/prog3.png" "$work/tty" >/dev/null 2>&1
   grep -q "estimate [0-9]* ms" "$work/tty" && [ -s "$work/prog3.png" ] && ok || bad "no ray estimate for the progress bar"
 fi
-"$SNELL" render "$SCENES/showcase.scn" --size 64 -o "$work/prog2.png" 2>"$work/err"
-! grep -q "elapsed" "$work/err" && ok || bad "progress written to a non-terminal"
+"$SNELL" render "$SCENES/showcase.scn" --size 64 -o "$work/prog2.png" 2>"$work/err"; status=$?
+[ $status -eq 0 ] && [ -s "$work/prog2.png" ] && ! grep -q "elapsed" "$work/err" && ok ||
+  bad "progress written to a non-terminal, or the render failed ($status)"
 
 # No runaway trees: settings that let an amplifying tree grow without bound
 # are refused before tracing (status 2, naming the sphere's material and a

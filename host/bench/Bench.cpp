@@ -16,6 +16,7 @@
 #include <sys/resource.h>
 #include <sys/wait.h>
 
+#include "common/Clock.h"
 #include "bench/PovExport.h"
 #include "common/Json.h"
 #include "gpu/ComputeRenderer.h"
@@ -35,11 +36,6 @@ namespace snell {
 namespace {
 
 namespace fs = std::filesystem;
-using Clock = std::chrono::steady_clock;
-
-double msSince(Clock::time_point start) {
-    return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 struct Stats {
     double median = 0.0, min = 0.0, max = 0.0;

@@ -8,6 +8,7 @@
 #include <sstream>
 #include <thread>
 
+#include "common/Clock.h"
 #include "check/SceneCheck.h"
 #include "cli/Command.h"
 #include "cli/ExitStatus.h"
@@ -28,10 +29,6 @@
 namespace snell::cli {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double msSince(Clock::time_point start) {
-    return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 struct RenderOptions {
     std::string scene;

@@ -9,6 +9,7 @@
 #include <functional>
 #include <thread>
 
+#include "common/Clock.h"
 #include "gpu/DriverProbe.h"
 #include "trace_comp_spv.h"       // generated at build time from shaders/trace.comp
 #include "trace_fp64_comp_spv.h"  // the same, compiled with SNELL_FP64
@@ -19,10 +20,6 @@ using vk::check;
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double msSince(Clock::time_point start) {
-    return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 constexpr VkBufferUsageFlags kStorage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
 
@@ -153,7 +150,7 @@ namespace {
 // q^k, q the largest gain of a lighter child (min(max ks, max kt) over the
 // materials), times gains of at most g = max(ks + kt) elsewhere. Where g <= 1
 // and q < 1 the weight must stay above the cut-off floor w, so k <= log w /
-// log q: 14 for the default 1e-4 and glass of ks 0.5, however deep the tree,
+// log q: 16 for the GPU's floor 1e-5 and glass of ks 0.5, however deep the tree,
 // and a chain of reflections needs none. Otherwise (amplifying materials, no
 // cut-off) the depth limit bounds k, up to kMaxRayStack; past that the
 // shader drops the child that would wait and counts it (SNELL_COUNTER_OVERFLOW).
@@ -169,7 +166,7 @@ std::uint32_t rayStackEntries(const Scene& scene, const TraceSettings& trace, bo
     for (const Material& m : scene.materials) {
         const double ks = std::max({m.ks.x, m.ks.y, m.ks.z}), kt = std::max({m.kt.x, m.kt.y, m.kt.z});
         if (ks > 0.0 && kt > 0.0) lighter = std::max(lighter, std::min(ks, kt));
-        gain = std::max({gain, m.ks.x + m.kt.x, m.ks.y + m.kt.y, m.ks.z + m.kt.z});
+        gain = std::max(gain, m.largestGain());
     }
     const auto depthBound = static_cast<std::uint32_t>(std::clamp(trace.maxDepth, 0, int(kMaxRayStack)));
     if (lighter == 0.0) return 0;

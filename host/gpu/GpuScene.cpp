@@ -85,7 +85,8 @@ GpuScene buildGpuScene(const snell::Scene& scene, const snell::Camera& camera, P
         bounds.reserve(scene.spheres.size());
         for (const snell::Sphere& s : scene.spheres) bounds.push_back(snell::sphereBounds(s));
         const snell::Bvh bvh = snell::buildBvh(bounds, SNELL_BVH_MAX_LEAF);
-        // Depth-first (pre-order) layout with skip links: stackless traversal.
+        // Depth-first (pre-order) layout with skip links: a node's first child follows it, the
+        // second is its skip link (trace.comp walks it with a short stack).
         std::vector<std::uint32_t> gpuIndexOf(bvh.nodes.size(), 0);
         std::vector<std::uint32_t> preorder;
         preorder.reserve(bvh.nodes.size());

@@ -1,16 +1,8 @@
 #include "image/BackgroundWriter.h"
 
-#include <chrono>
+#include "common/Clock.h"
 
 namespace snell {
-namespace {
-
-using Clock = std::chrono::steady_clock;
-double msSince(Clock::time_point start) {
-    return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
-
-}  // namespace
 
 BackgroundWriter::BackgroundWriter(std::unique_ptr<ImageWriter> writer, int width, int maxQueuedRows)
     : writer_(std::move(writer)), width_(width), maxQueuedRows_(std::max(1, maxQueuedRows)) {}

@@ -17,7 +17,7 @@ RadianceBound radianceBound(const Scene& scene) {
     for (const Light& light : scene.lights) lights += light.colour;
     for (const Material& m : scene.materials) {
         b.local = glm::max(b.local, scene.ambient * m.kd + lights * (m.kd + m.ks));
-        b.gain = glm::max(b.gain, m.ks + m.kt);
+        b.gain = glm::max(b.gain, m.gain());
     }
     for (int c = 0; c < 3; ++c) {
         if (b.local[c] == 0.0) b.radiance[c] = 0.0;  // no light in this channel at all
@@ -79,7 +79,7 @@ TreeSizeBound treeSizeBound(const Scene& scene, int maxDepth, double minWeight) 
     for (std::size_t i = 0; i < scene.spheres.size(); ++i) {
         const Material& m = scene.materials[scene.spheres[i].material];
         branches = branches || (m.reflects() && m.refracts());
-        const double g = std::max({m.ks.x + m.kt.x, m.ks.y + m.kt.y, m.ks.z + m.kt.z});
+        const double g = m.largestGain();
         if (g > b.gain) {
             b.gain = g;
             b.sphere = i;

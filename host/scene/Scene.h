@@ -3,6 +3,7 @@
 // by the GPU layout (host/gpu/GpuScene.h).
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <functional>
 #include <string>
@@ -34,10 +35,12 @@ struct Material {
 
     bool reflects() const { return ks.x != 0.0 || ks.y != 0.0 || ks.z != 0.0; }
     bool refracts() const { return kt.x != 0.0 || kt.y != 0.0 || kt.z != 0.0; }
+    // What a hit passes on to its children, per channel: ks + kt.
+    dvec3 gain() const { return ks + kt; }
+    // The largest channel of gain().
+    double largestGain() const { return std::max({ks.x + kt.x, ks.y + kt.y, ks.z + kt.z}); }
     // SPEC §4 "amplifying": a ray tree that can gain weight with depth.
-    bool amplifies() const {
-        return ks.x + kt.x > 1.0 || ks.y + kt.y > 1.0 || ks.z + kt.z > 1.0;
-    }
+    bool amplifies() const { return largestGain() > 1.0; }
     bool operator==(const Material&) const = default;
 };
 
