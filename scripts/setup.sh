@@ -36,7 +36,7 @@ debian_mirror() {
   local uri
   uri=$(cat /etc/apt/sources.list /etc/apt/sources.list.d/*.list 2>/dev/null |
         awk '$1 == "deb" { for (i = 2; i <= NF; i++) if ($i !~ /^\[/ && $i !~ /\]$/) break;
-                           if ($(i + 1) == "bookworm") { print $i; exit } }')
+                           if ($(i + 1) == "bookworm") { print $i; exit } }' || true)
   if [ -z "$uri" ]; then
     uri=$(cat /etc/apt/sources.list.d/*.sources 2>/dev/null |
           awk 'BEGIN { RS = ""; FS = "\n" }
@@ -45,7 +45,7 @@ debian_mirror() {
                    if ($i ~ /^URIs:/) { uris = $i; sub(/^URIs:[ \t]*/, "", uris) }
                    if ($i ~ /^Suites:/) { suites = " " $i " "; sub(/^ Suites:/, "", suites) }
                    if ($i ~ /^Enabled:[ \t]*no/) enabled = 0 }
-                 if (enabled && suites ~ /[ \t]bookworm[ \t]/) { split(uris, u, /[ \t]+/); print u[1]; exit } }')
+                 if (enabled && suites ~ /[ \t]bookworm[ \t]/) { split(uris, u, /[ \t]+/); print u[1]; exit } }' || true)
   fi
   echo "${uri:-http://deb.debian.org/debian}"
 }
