@@ -31,15 +31,25 @@ void requireSameSize(const Image& a, const Image& b, const char* what) {
                                     std::to_string(b.height));
 }
 
-// The largest channel difference of pixel p in 1/255 units, counting non-finite values.
-int worstDifference(const Image& test, const Image& reference, std::size_t p, std::uint64_t& nonFinite) {
+// Pixel p's channel differences in 1/255 units: the largest, their sum and
+// sum of squares, and the test pixel's NaN or infinite values.
+struct PixelDifference {
     int worst = 0;
+    double sum = 0.0, sumSquares = 0.0;
+    int nonFinite = 0;
+};
+
+PixelDifference difference(const Image& test, const Image& reference, std::size_t p) {
+    PixelDifference d;
     for (int k = 0; k < 3; ++k) {
         const float a = test.rgb[p * 3 + k];
-        if (!std::isfinite(a)) ++nonFinite;
-        worst = std::max(worst, std::abs(int(toByte(a)) - int(toByte(reference.rgb[p * 3 + k]))));
+        d.nonFinite += std::isfinite(a) ? 0 : 1;
+        const int diff = std::abs(int(toByte(a)) - int(toByte(reference.rgb[p * 3 + k])));
+        d.worst = std::max(d.worst, diff);
+        d.sum += diff;
+        d.sumSquares += double(diff) * diff;
     }
-    return worst;
+    return d;
 }
 
 // Off by more than 8/255 while all eight neighbours are within 2/255.
@@ -68,27 +78,24 @@ ImageMetrics compareImages(const Image& test, const Image& reference, int badThr
     std::vector<int> worstOf(pixels, 0);
     double sum = 0.0, sumSquares = 0.0;
     for (std::size_t p = 0; p < pixels; ++p) {
-        const int worst = worstDifference(test, reference, p, m.nonFinite);
+        const PixelDifference d = difference(test, reference, p);
+        m.nonFinite += d.nonFinite;
         if (referenceBound) {
             const float* b = &referenceBound->rgb[p * 3];
             const double bound = 255.0 * std::max({b[0], b[1], b[2]});
-            // NaN or an unclamped bound never certifies; a bound cannot excuse a NaN.
+            // A NaN bound never certifies; no bound excuses a NaN pixel.
             const bool certified = bound <= 0.5;
-            const bool provenWrong = double(worst) > std::ceil(bound) + badThreshold || !std::isfinite(test.rgb[p * 3]) ||
-                                     !std::isfinite(test.rgb[p * 3 + 1]) || !std::isfinite(test.rgb[p * 3 + 2]);
+            const bool provenWrong = double(d.worst) > std::ceil(bound) + badThreshold || d.nonFinite > 0;
             if (!certified && !provenWrong) {
                 ++m.uncertain;
                 continue;
             }
         }
-        for (int k = 0; k < 3; ++k) {
-            const int diff = std::abs(int(toByte(test.rgb[p * 3 + k])) - int(toByte(reference.rgb[p * 3 + k])));
-            sum += diff;
-            sumSquares += double(diff) * diff;
-        }
-        worstOf[p] = worst;
-        m.maxError = std::max(m.maxError, worst);
-        if (worst > badThreshold) ++m.badPixels;
+        sum += d.sum;
+        sumSquares += d.sumSquares;
+        worstOf[p] = d.worst;
+        m.maxError = std::max(m.maxError, d.worst);
+        if (d.worst > badThreshold) ++m.badPixels;
     }
     m.pixels = pixels - m.uncertain;
     m.speckles = countSpeckles(worstOf, test.width, test.height);
