@@ -357,9 +357,15 @@ struct Hit {
 float etaOfSphere(uint sphere) { return materialKt(sphereMaterial(sphere)).w; }
 
 // An invocation's entries in the ray and media buffers: its stack of
-// RAY_STACK entries, then its frontier of FRONTIER.
-uint stackEntry(uint slot, uint k) { return slot * (RAY_STACK + FRONTIER) + k; }
-uint frontierEntry(uint slot, uint k) { return slot * (RAY_STACK + FRONTIER) + RAY_STACK + k % max(FRONTIER, 1u); }
+// RAY_STACK entries, then its frontier of FRONTIER, entry k of every
+// invocation side by side (k · invocations + slot). Side by side, the lanes of
+// a subgroup touch neighbouring memory (coalesced on a GPU), and a render
+// whose rays wait in few entries touches few pages: laid out an invocation
+// after another, each invocation's first frontier entry was a page of its own,
+// and on lavapipe faulting those pages in cost 1–2 ms a render.
+uint invocations;  // of this dispatch (main)
+uint stackEntry(uint slot, uint k) { return k * invocations + slot; }
+uint frontierEntry(uint slot, uint k) { return (RAY_STACK + k % max(FRONTIER, 1u)) * invocations + slot; }
 
 void storeRay(uint entry, Ray r) {
 #ifdef SNELL_FP64
@@ -659,6 +665,7 @@ Ray cameraRay(uvec2 p, uint k) {
 void main() {
     uint slot = gl_GlobalInvocationID.x;
     uint slots = gl_NumWorkGroups.x * uint(SNELL_WORKGROUP_SIZE);
+    invocations = slots;
     uint tilePixels = tile.width * tile.height;
     [[unroll]] for (int k = 0; k < SNELL_RAY_COUNTER_COUNT; ++k) countedRays[k] = 0u;
     [[unroll]] for (uint i = 0u; i < SPHERE_COUNT; ++i) {
@@ -736,16 +743,15 @@ void main() {
             bool certified = bound <= tolerance;
             bool settled = frame.estimate != 0u && unbounded && estimate <= tolerance &&
                            (state.amplified == 0u || estimate <= frame.localRadiance.w);
-            // The next rung: the highest that traces a ray this step left,
-            // not under the floor; but a pixel whose trees gained weight
-            // goes on below it, until its diverging channels saturate or
-            // its trees reach the budget (SPEC §4 amplifying materials; as
-            // CpuRenderer::renderPixel does).
+            // The next rung: four below the heaviest ray this step left
+            // (render/RenderRequest.h, nextRung), not under the floor; but a
+            // pixel whose trees gained weight goes on below it, until its
+            // diverging channels saturate or its trees reach the budget
+            // (SPEC §4 amplifying materials; as CpuRenderer::renderPixel does).
             float heaviest = state.cutOff.y;
             bool belowFloor = AMPLIFYING && unbounded && state.amplified != 0u && pixelBudget != 0u;
-            // (Below the floor it steps 16x at a time: such a pixel goes on
-            // to the budget or saturation anyway, and fewer steps cost less.)
-            float next = belowFloor ? cutOffRung(heaviest) / 16.0 : max(floorCutOff, cutOffRung(heaviest));
+            float next = cutOffRung(heaviest) / 16.0;
+            if (!belowFloor) next = max(floorCutOff, next);
             if (tolerance > 0.0 && !certified && !settled && heaviest > 0.0 && next > 0.0 && next <= heaviest &&
                 state.overBudget == 0u) {
                 cutOff = next;

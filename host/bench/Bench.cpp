@@ -293,13 +293,71 @@ struct SceneRun {
     RenderRequest base;
     const Image& exact;
     int runs = 5;
+    bool quick = false;  // a quick run (BenchOptions::quick)
     const std::atomic<bool>* cancel = nullptr;
     std::map<std::pair<int, int>, std::unique_ptr<ComputeRenderer>> renderers;
 
-    // A warm-up, `runs` timed renders and one that counts the rays; the error
-    // of the first timed image against the exact one.
+    // A warm-up, the timed renders (timedRuns) and one that counts the rays;
+    // the error of the first timed image against the exact one.
     Result measure(const Setting& setting);
+    // The dispatch times of settings a and b, rendered in turn in blocks
+    // (kSideBySideRounds of a, then of b, each of `runs` timed renders after
+    // an untimed one): side by side, so that a drift of the machine's speed
+    // moves both alike. Not render by render: switching renderers at every
+    // render evicts the other's data from the caches, which added 1 ms to a
+    // 0.5 ms dispatch and so moved their ratio towards 1.
+    std::pair<Stats, Stats> measureSideBySide(const Setting& a, const Setting& b, int runs);
+
+    RenderRequest requestFor(const Setting& setting) const;
+    ComputeRenderer& rendererFor(const Setting& setting);
 };
+
+// Timed renders of a setting whose warm-up took warmUpMs: at least `runs`,
+// and for a cheap one as many as fill kTimedBudgetMs (at most kMaxTimedRuns):
+// a median of five sub-millisecond dispatches moves by tens of per cent from
+// run to run, and the price of the default is a ratio of two of them. Not in
+// a quick run (CI), which checks what the bench reports, not its figures.
+constexpr double kTimedBudgetMs = 200.0;
+constexpr int kMaxTimedRuns = 101;
+int timedRuns(int runs, double warmUpMs, bool quick) {
+    if (quick || !(warmUpMs > 0.0)) return runs;
+    return std::clamp(int(std::ceil(kTimedBudgetMs / warmUpMs)), runs, std::max(runs, kMaxTimedRuns));
+}
+
+RenderRequest SceneRun::requestFor(const Setting& setting) const {
+    RenderRequest request = base;
+    request.trace.maxDepth = setting.depth;
+    request.trace.minWeight = setting.minWeight;
+    request.trace.tolerance = setting.tolerance;
+    if (setting.supersample) request.supersample = setting.supersample;
+    return request;
+}
+
+ComputeRenderer& SceneRun::rendererFor(const Setting& setting) {
+    auto& renderer = renderers[{int(setting.precision), int(setting.bvh)}];
+    if (!renderer)
+        renderer = std::make_unique<ComputeRenderer>(context, scene, base.camera, setting.precision, setting.bvh);
+    return *renderer;
+}
+
+constexpr int kSideBySideRounds = 3;
+std::pair<Stats, Stats> SceneRun::measureSideBySide(const Setting& a, const Setting& b, int runs) {
+    const RenderRequest requestA = requestFor(a), requestB = requestFor(b);
+    // A renderer each: one keeps one pipeline and its buffers, and a render
+    // with another specialisation would re-create them.
+    ComputeRenderer& rendererA = rendererFor(a);
+    ComputeRenderer rendererB(context, scene, base.camera, b.precision, b.bvh);
+    std::vector<double> msA, msB;
+    auto block = [&](ComputeRenderer& renderer, const RenderRequest& request, std::vector<double>& ms) {
+        renderer.render(request, false);
+        for (int k = 0; k < runs; ++k) ms.push_back(renderer.render(request, false).renderMs);
+    };
+    for (int round = 0; round < kSideBySideRounds; ++round) {
+        block(rendererA, requestA, msA);
+        block(rendererB, requestB, msB);
+    }
+    return {stats(msA), stats(msB)};
+}
 
 Result SceneRun::measure(const Setting& setting) {
     Result r;
@@ -308,29 +366,24 @@ Result SceneRun::measure(const Setting& setting) {
     r.setting = setting;
     r.size = base.width;
     r.spheres = int(scene.spheres.size());
-    RenderRequest request = base;
-    request.trace.maxDepth = setting.depth;
-    request.trace.minWeight = setting.minWeight;
-    request.trace.tolerance = setting.tolerance;
+    RenderRequest request = requestFor(setting);
     request.truncation = &r.bound;
-    if (setting.supersample) request.supersample = setting.supersample;
     r.supersample = request.supersample;
     try {
-        auto& renderer = renderers[{int(setting.precision), int(setting.bvh)}];
-        if (!renderer)
-            renderer = std::make_unique<ComputeRenderer>(context, scene, base.camera, setting.precision, setting.bvh);
-        r.bvhUsed = renderer->layout().usesBvh();
-        renderer->render(request, false);  // warm-up: pipeline and first dispatch
+        ComputeRenderer& renderer = rendererFor(setting);
+        r.bvhUsed = renderer.layout().usesBvh();
+        const double warmUpMs = renderer.render(request, false).renderMs;  // and pipeline and first dispatch
         std::vector<double> ms;
         Image image;
-        for (int k = 0; k < runs; ++k) {
-            GpuRenderResult g = renderer->render(request, false);
+        const int n = timedRuns(runs, warmUpMs, quick);
+        for (int k = 0; k < n; ++k) {
+            GpuRenderResult g = renderer.render(request, false);
             ms.push_back(g.renderMs);
             r.gpuTimed = g.gpuTimed;
             if (k == 0) image = std::move(g.image);
         }
         r.dispatchMs = stats(ms);
-        r.rays = renderer->render(request, true).rays;
+        r.rays = renderer.render(request, true).rays;
         r.error = compareImages(image, exact);
     } catch (const vk::VulkanError& e) {
         if (cancel && cancel->load()) throw;
@@ -469,6 +522,7 @@ struct Price {
     double fixedMs = NAN, fixedMean = NAN;
     std::uint64_t fixedBad = 0;
     int tried = 0;  // fixed trees measured
+    int sideBySideRuns = 0;  // each setting's timed renders the price is from (retimePrice); 0: the sweep's
     // The default's pixels by how they stopped (render/Truncation.h): within
     // the tolerance (certified), by an estimated error, and those whose lost
     // light has no finite bound and that no estimate stopped; besides these,
@@ -511,6 +565,26 @@ Price priceOf(const std::vector<Result>& results, std::size_t def, const std::ve
     return p;
 }
 
+// The price again from the default and the fixed tree that sets it timed side
+// by side (SceneRun::measureSideBySide): chosen as the fastest of many noisy
+// medians, that tree's own median is biased low (the winner's curse), and
+// the sweep timed the default before the trees, minutes apart on a big scene.
+constexpr int kSideBySideRuns = 5;  // a block's timed renders, at the least
+void retimePrice(SceneRun& run, const std::vector<Result>& results, std::size_t def, Price& p) {
+    if (std::isnan(p.price)) return;
+    const auto setter = std::find_if(results.begin() + std::ptrdiff_t(def), results.end(),
+                                     [&](const Result& r) { return r.setting.name == p.fixed && r.setting.front; });
+    if (setter == results.end()) return;
+    const double pairMs = results[def].dispatchMs.median + setter->dispatchMs.median;
+    const int runs = timedRuns(kSideBySideRuns, pairMs * kSideBySideRounds, run.quick);
+    const auto [defaultMs, fixedMs] = run.measureSideBySide(results[def].setting, setter->setting, runs);
+    if (!(defaultMs.median > 0.0) || !(fixedMs.median > 0.0)) return;
+    p.defaultMs = defaultMs.median;
+    p.fixedMs = fixedMs.median;
+    p.price = p.defaultMs / p.fixedMs;
+    p.sideBySideRuns = runs * kSideBySideRounds;
+}
+
 std::string brief(double v) {  // three significant digits, for the log
     std::ostringstream s;
     s.precision(3);
@@ -526,7 +600,10 @@ std::string describe(const Price& p) {
     } else {
         s << "price of the default " << (p.upperBound ? "< " : "") << brief(p.price) << "x ("
           << (p.upperBound ? "no fixed tree as accurate; slowest tried " : "") << p.fixed << ": "
-          << brief(p.fixedMs) << " ms, mean " << brief(p.fixedMean) << "/255, " << p.fixedBad << " bad)";
+          << brief(p.fixedMs) << " ms, mean " << brief(p.fixedMean) << "/255, " << p.fixedBad << " bad";
+        if (p.sideBySideRuns)
+            s << "; default " << brief(p.defaultMs) << " ms; timed side by side, " << p.sideBySideRuns << " runs each";
+        s << ")";
     }
     s << "; default mean " << brief(p.defaultMean) << "/255, " << p.defaultBad << " bad; pixels " << p.certified
       << " certified, " << p.estimated << " estimated, " << p.unboundedNotEstimated << " unbounded not estimated";
@@ -681,7 +758,7 @@ void benchScene(vk::Context& context, const BenchOptions& o, const SceneFile& fi
     cpu.render(base);
     out.cpuDefaultMs[name] = msSince(sameStart);
 
-    SceneRun run{context, scene, name, file.group, base, exact, runs, o.cancel, {}};
+    SceneRun run{context, scene, name, file.group, base, exact, runs, o.quick, o.cancel, {}};
     const std::size_t def = out.results.size();
     for (const Setting& setting : settingsFor(scene, o.quick)) out.results.push_back(run.measure(setting));
     {
@@ -693,6 +770,7 @@ void benchScene(vk::Context& context, const BenchOptions& o, const SceneFile& fi
     std::vector<std::size_t> tried;
     if (out.results[def].failure.empty()) tried = fixedSweep(run, out.results, def, o.quick);
     out.prices.push_back(priceOf(out.results, def, tried));
+    retimePrice(run, out.results, def, out.prices.back());
     log << "  " << describe(out.prices.back()) << "\n";
 
     if (file.group == "bench") out.peers.push_back(measurePeer(context, o, file, scene, cpu, base, runs, log));
@@ -804,6 +882,7 @@ void writePriceJson(std::ostream& json, const Price& p) {
          << ", \"fixed_setting\": " << (p.fixed.empty() ? "null" : jsonString(p.fixed))
          << ", \"fixed_ms\": " << number(p.fixedMs) << ", \"fixed_mean_abs_error\": " << number(p.fixedMean)
          << ", \"fixed_bad_pixels\": " << p.fixedBad << ", \"fixed_tried\": " << p.tried
+         << ", \"side_by_side_runs\": " << p.sideBySideRuns
          << ", \"pixels\": {\"total\": " << p.pixels << ", \"certified\": " << p.certified
          << ", \"estimated\": " << p.estimated << ", \"unbounded_not_estimated\": " << p.unboundedNotEstimated
          << ", \"over_tolerance\": " << p.overTolerance << ", \"over_budget\": " << p.overBudget << "}}";

@@ -351,7 +351,7 @@ CpuRenderer::Pixel CpuRenderer::renderPixel(const RenderRequest& request, int x,
     Pixel pixel;
     // The pixel's trees at the first cut-off; then, while its bound is over
     // the tolerance, the rays they left under the cut-off are traced on with
-    // the next rung at or below the heaviest of them: together the very tree
+    // the next rung (nextRung, below the heaviest of them): together the very tree
     // one pass at that cut-off traces, with no ray traced twice. What each
     // step proves is kept (PixelEstimate).
     PixelEstimate estimate;
@@ -393,15 +393,13 @@ CpuRenderer::Pixel CpuRenderer::renderPixel(const RenderRequest& request, int x,
             pixel.overTolerance = false;
             break;
         }
-        // The next rung: the highest that traces a ray the last step left, not
-        // under the floor; but a pixel whose trees gained weight goes on below
-        // it, until its diverging channels saturate or its trees reach the
-        // budget (SPEC §4 amplifying materials).
+        // The next rung: kRungsDown below the heaviest ray the last step left,
+        // not under the floor; but a pixel whose trees gained weight goes on
+        // below it, until its diverging channels saturate or its trees reach
+        // the budget (SPEC §4 amplifying materials).
         const bool belowFloor = tree.amplified && pixel.unbounded && tree.budget != 0;
-        const double rung = cutOffRung(tree.heaviestDeferred);
-        // (Below the floor it steps 16x at a time: such pixels go on to the
-        // budget or saturation anyway, and fewer steps cost less.)
-        const double cutOff = belowFloor ? rung / 16.0 : std::max(settings.minWeight, rung);
+        const double rung = nextRung(tree.heaviestDeferred);
+        const double cutOff = belowFloor ? rung : std::max(settings.minWeight, rung);
         // Everything left is under the floor, or the budget is spent.
         if (cutOff > tree.heaviestDeferred || !(cutOff >= std::numeric_limits<float>::min()) || tree.overBudget) break;
         std::vector<PendingRay> waiting = std::move(tree.frontier);

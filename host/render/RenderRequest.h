@@ -63,15 +63,23 @@ inline constexpr TraceSettings kDefaultSettings{.maxDepth = 10000,
 inline constexpr TraceSettings kPreviewSettings{.maxDepth = 64, .minWeight = 1e-4};
 
 // The cut-offs a tolerance tries are rungs 2^-k of one ladder, from kFirstRung
-// down, whatever the tolerance: each step traces on from the rays the last one
-// left, so the tree at a rung is the same however it was reached, and a looser
-// tolerance stops on the same rung or a higher one: it never traces more.
+// down, each set by the tree alone, whatever the tolerance: each step traces on
+// from the rays the last one left, so the tree at a rung is the same however
+// it was reached, and a looser tolerance stops on the same rung or a higher
+// one: it never traces more.
 inline constexpr double kFirstRung = 0.25;
+// A step goes kRungsDown rungs of 2 below the heaviest ray the last one left
+// (a factor of 16 in weight): a step costs more than a pixel's few extra rays
+// (each step re-reads the rays it leaves waiting), so fewer, deeper steps are
+// the cheaper way to the same accuracy (docs/performance.md, "The price of
+// the default"). trace.comp steps the same.
+inline constexpr int kRungsDown = 4;
 inline double cutOffRung(double weight) {  // the highest rung <= weight (weight > 0)
     int exponent = 0;
     std::frexp(weight, &exponent);  // weight = m · 2^exponent, m in [1/2, 1)
     return std::ldexp(0.5, exponent);
 }
+inline double nextRung(double heaviestLeft) { return std::ldexp(cutOffRung(heaviestLeft), -kRungsDown); }
 
 struct RayCounts {
     std::uint64_t primary = 0;
