@@ -1,8 +1,9 @@
 // The one declaration of everything the host and the compute shader share:
 // binding numbers, workgroup size, specialization-constant ids and the structs
 // of the scene's buffers. Included by C++ (host/gpu/GpuScene.h) and by GLSL
-// (shaders/trace.comp). Members are vec4, mat4 or uint only, so std430 and
-// C++ agree without padding rules; host/gpu/GpuScene.h static_asserts sizes.
+// (shaders/trace.comp). Members are vec4, mat4, uint or float only, the
+// 4-byte scalars after the vectors (never vec3), so std140, std430 and C++
+// agree without padding rules; host/gpu/GpuScene.h static_asserts sizes.
 //
 // The scene is read-only and reaches the shader as uniform texel buffers, each
 // struct below a run of RGBA32 texels (its vec4 members in order): texel
@@ -180,10 +181,7 @@ struct SlotState {
     vec4 lost;       // rgb: the weight of rays lost for good (depth limit, floor, tree budget, full stack)
     vec4 lower;      // rgb: the pixel's best lower and upper bounds over its steps so far
     vec4 upper;      //      (render/Truncation.h, PixelEstimate)
-    vec4 settled;    // rgb: its colour after the last step, clamped; w: the weight it had not traced then, in
-                     // channels under 1, per sample (render/Truncation.h, ErrorEstimate)
-    vec4 cutOff;     // x: this step's cut-off; y: the heaviest ray it deferred; z, w: how far the
-                     // last step and the one before moved the colour
+    vec4 settled;    // rgb: its colour after the last step, clamped (render/Truncation.h, ErrorEstimate)
     uint pixel;      // the pixel of the tile in progress (row-major); ≥ tile size: done
     uint started;    // samples of it started
     uint pending;    // rays waiting on this invocation's stack
@@ -196,6 +194,14 @@ struct SlotState {
     uint frontierCount;  // its entries
     uint frontierOld;    // of those, the ones the last step left, still to trace in this one
     uint amplified;      // 1: a hit of its trees gained weight (ks + kt > 1 where the ray carried light)
+    float cutOff;        // this step's cut-off
+    float heaviestLeft;  // the heaviest ray this step left in the frontier
+    float lastMove;      // how far the last step moved the colour (ErrorEstimate)
+    float moveBefore;    // and the step before it
+    float settledWeight; // the weight the pixel had not traced after the last step, in channels under 1, per sample
+    uint pad0;
+    uint pad1;
+    uint pad2;
 };
 
 // What the shader writes for each pixel of a tile.
@@ -227,13 +233,10 @@ struct FrameParams {
     vec4 cornerDir;     // xyz: image-plane corner (pixel coords 0,0) minus eye
     vec4 pixelRight;    // xyz: one pixel step along a row
     vec4 pixelDown;     // xyz: one pixel step down a column
-    vec4 background;    // rgb background, w = eta of air
-    vec4 ambient;       // rgb ambient, w = minimum ray weight (with a tolerance: the lowest cut-off tried)
-    vec4 radiance;      // rgb: the radiance bound R (render/Truncation.h), +inf where light need not decay;
-                        // w: the tolerance on each pixel's truncation bound, 0: none
-    vec4 localRadiance; // rgb: the most light one hit or miss returns, its children aside (RadianceBound::local);
-                        // w: the estimated error within which a pixel whose trees gained weight may stop
-                        // (render/Truncation.h, kAmplifiedEstimate)
+    vec4 background;    // rgb
+    vec4 ambient;       // rgb
+    vec4 radiance;      // rgb: the radiance bound R (render/Truncation.h), +inf where light need not decay
+    vec4 localRadiance; // rgb: the most light one hit or miss returns, its children aside (RadianceBound::local)
     uint imageWidth;
     uint imageHeight;
     uint supersample;
@@ -245,6 +248,11 @@ struct FrameParams {
     uint sampleCount;   // of the supersample² grid (row-major), and output their mean
     uint treeBudget;    // the most rays a pixel's trees may trace, per sample; 0: no limit
     uint estimate;      // 1: an unbounded pixel stops on its estimated error (TraceSettings::estimate)
+    float minWeight;    // the weight cut-off (with a tolerance: the floor, the lowest cut-off tried)
+    float tolerance;    // on each pixel's truncation bound; 0: none (a fixed tree)
+    float amplifiedEstimate;  // the estimated error within which a pixel whose trees gained weight may
+                              // stop (render/Truncation.h, kAmplifiedEstimate)
+    float airEta;       // the index of refraction outside every sphere (SPEC §4.5)
     uint pad0;
 };
 

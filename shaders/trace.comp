@@ -59,9 +59,6 @@ void countLanes(bool busy, inout uint slots, inout uint used) {
 layout(constant_id = SNELL_SPEC_MAX_MEDIA) const int MAX_MEDIA = 1;
 layout(constant_id = SNELL_SPEC_RAY_STACK) const uint RAY_STACK = 1u;
 layout(constant_id = SNELL_SPEC_AMPLIFYING) const bool AMPLIFYING = false;
-// Loop iterations a subgroup may spend in one dispatch before its invocations
-// suspend; 0: no limit (drivers without llvmpipe's old loop limiter).
-layout(constant_id = SNELL_SPEC_LOOP_BUDGET) const uint LOOP_BUDGET = 0u;
 // Entries of an invocation's frontier: the rays a step leaves under its
 // cut-off, which the next step traces on (0: a fixed tree, nothing deferred).
 layout(constant_id = SNELL_SPEC_FRONTIER) const uint FRONTIER = 0u;
@@ -73,6 +70,7 @@ layout(constant_id = SNELL_SPEC_SHADOWS) const bool SHADOWS = true;
 // pixel's truncation bound), and its own bookkeeping.
 layout(set = 0, binding = SNELL_BINDING_OUTPUT, std430) writeonly buffer OutputBlock { OutputPixel outputPixels[]; };
 layout(set = 0, binding = SNELL_BINDING_COUNTERS, std430) buffer CounterBlock { uint counters[]; };
+#include "loop_budget.glsl"  // (it reports through the counters)
 layout(set = 0, binding = SNELL_BINDING_SLOT_STATES, std430) buffer SlotStateBlock { SlotState slotStates[]; };
 layout(set = 0, binding = SNELL_BINDING_RAY_STACK, std430) buffer RayStackBlock { PendingRay rayStack[]; };
 layout(set = 0, binding = SNELL_BINDING_MEDIA_STACK, std430) buffer MediaStackBlock { uint mediaStack[]; };
@@ -136,19 +134,6 @@ const uint NONE = 0xffffffffu;
 
 uint countedRays[SNELL_RAY_COUNTER_COUNT];
 
-// Loop iterations this subgroup has run in this dispatch, as llvmpipe's loop
-// limiter counts them (at least): it counts every pass of a loop with some lane
-// active, and a loop that no lane enters still runs its body once (masked),
-// as old llvmpipe executes both sides of every branch. One lane of the active
-// ones counts each pass, so the subgroup's sum is the count; where a pass may
-// hold a loop that no lane enters, it counts that loop's one pass too. The
-// shader's only loops are the passes over rays, over lights, and of the BVH
-// walk or the sphere loop; the rest are unrolled. Compiled out when
-// LOOP_BUDGET is 0.
-uint loopTicks = 0u;
-void tick(uint passes) {
-    if (LOOP_BUDGET != 0u && subgroupElect()) loopTicks += passes;
-}
 
 // ---------------------------------------------------------------------------
 // Intersection: the maths is in intersect.glsl (shared with the test kernel);
@@ -298,7 +283,7 @@ bool occluded(rvec3 origin, rvec3 dir, real distance, uint fromSphere, uint star
 // it heads into that sphere, and its medium stack (innermost last).
 
 // cutOff: that of the pixel in hand, the minimum weight or, under a
-// tolerance, the one its current step uses (SlotState.cutOff.x). (The
+// tolerance, the one its current step uses (SlotState.cutOff). (The
 // per-pixel values live in main's locals and are passed down: Mesa 22.3's
 // llvmpipe keeps memory for every dispatch of a shader with such private
 // globals, tests/soak_test.sh.)
@@ -408,11 +393,11 @@ Ray popRay(uint slot, inout uint pending) {
 void deferRay(uint slot, inout SlotState state, Ray r) {
     float m = max(r.weight.r, max(r.weight.g, r.weight.b));
     if (!(m > 0.0)) return;
-    if (FRONTIER > 0u && state.frontierCount < FRONTIER && (AMPLIFYING || m >= frame.ambient.w)) {
+    if (FRONTIER > 0u && state.frontierCount < FRONTIER && (AMPLIFYING || m >= frame.minWeight)) {
         storeRay(frontierEntry(slot, state.frontierHead + state.frontierCount), r);
         state.frontierCount++;
         state.deferred.rgb += r.weight;
-        state.cutOff.y = max(state.cutOff.y, m);
+        state.heaviestLeft = max(state.heaviestLeft, m);
     } else {
         state.lost.rgb += r.weight;
     }
@@ -423,7 +408,7 @@ void deferRay(uint slot, inout SlotState state, Ray r) {
 // traced now rather than lost: the tree only grows, and no step traces any
 // ray twice).
 float tracingCutOff(SlotState state, float cutOff) {
-    return FRONTIER > 0u && state.frontierCount >= FRONTIER ? frame.ambient.w : cutOff;
+    return FRONTIER > 0u && state.frontierCount >= FRONTIER ? frame.minWeight : cutOff;
 }
 
 // 1–2. The closest hit of ray r: on a miss the background is added to the
@@ -503,15 +488,16 @@ float estimateError(inout SlotState state, float samples) {
     float weight = max(open.r, max(open.g, open.b));
     if (state.steps > 0u) {
         vec3 moved = abs(colour - state.settled.rgb);
-        state.cutOff.w = state.cutOff.z;
-        state.cutOff.z = max(moved.r, max(moved.g, moved.b));
+        state.moveBefore = state.lastMove;
+        state.lastMove = max(moved.r, max(moved.g, moved.b));
     }
-    float previousWeight = state.steps > 0u ? state.settled.w : INFINITY;
-    state.settled = vec4(colour, weight);
+    float previousWeight = state.steps > 0u ? state.settledWeight : INFINITY;
+    state.settled = vec4(colour, 0.0);
+    state.settledWeight = weight;
     state.steps++;
     if (state.steps < 3u || !(weight < previousWeight)) return INFINITY;
-    float change = state.cutOff.z;
-    float rho = max(change / state.cutOff.w, weight / previousWeight);
+    float change = state.lastMove;
+    float rho = max(change / state.moveBefore, weight / previousWeight);
     if (!(rho < 1.0) && change > 0.0) return INFINITY;
     return max(weight, change > 0.0 ? change / (1.0 - rho) : 0.0);
 }
@@ -520,30 +506,72 @@ float estimateError(inout SlotState state, float samples) {
 // cleared, a power of two (render/RenderRequest.h, cutOffRung).
 float cutOffRung(float w) { return uintBitsToFloat(floatBitsToUint(w) & 0x7f800000u); }
 
+// The refractive index of the medium ray r travels in over that of the
+// medium it refracts into at hit h (SPEC §4.5, the medium stack). Leaving a
+// sphere, removeAt is where it is in the stack (its innermost occurrence;
+// r.mediaCount where absent: nothing is removed); entering, it is unchanged.
+real relativeIndex(Ray r, Hit h, inout uint removeAt) {
+    if (h.fromOutside) {
+        // Entering: from the current medium into this sphere.
+        return (r.mediaCount == 0u ? frame.airEta : etaOfSphere(mediumAt(r.mediaCount - 1u))) / real(h.kt.w);
+    }
+    // Leaving: into the medium that remains once this sphere is removed.
+    [[unroll]] for (int k = 0; k < MAX_MEDIA; ++k)
+        if (uint(k) < r.mediaCount && media[k] == h.sphere) removeAt = uint(k);
+    uint innermost = NONE;  // the innermost one that stays
+    [[unroll]] for (int k = 0; k < MAX_MEDIA; ++k)
+        if (uint(k) < r.mediaCount && uint(k) != removeAt) innermost = media[k];
+    return real(h.kt.w) / (innermost == NONE ? frame.airEta : etaOfSphere(innermost));
+}
+
+// The medium stack (`media`, `count` entries) of a ray refracted at hit h:
+// entering, the sphere is pushed (a stack deeper than the scene can nest
+// forgets its outermost); leaving, entry removeAt is removed. Returns the new
+// count.
+uint crossSurface(Hit h, uint count, uint removeAt) {
+    if (h.fromOutside) {
+        if (count == uint(MAX_MEDIA)) {
+            [[unroll]] for (int k = 0; k + 1 < MAX_MEDIA; ++k) media[k] = media[k + 1];
+            count--;
+        }
+        [[unroll]] for (int k = 0; k < MAX_MEDIA; ++k)
+            if (uint(k) == count) media[k] = h.sphere;
+        return count + 1u;
+    }
+    if (removeAt < count) {
+        [[unroll]] for (int k = 0; k + 1 < MAX_MEDIA; ++k)
+            if (uint(k) >= removeAt && uint(k) + 1u < count) media[k] = media[k + 1];
+        count--;
+    }
+    return count;
+}
+
+// Light carried into a material of ks + kt > 1 (SPEC §4 amplifying
+// materials) can grow: an orbit of total internal reflection repeats its
+// angle for ever, and a path of tiny weight that enters one grows until its
+// channel saturates. The pixel's series may diverge behind steps that seem to
+// settle, so its estimated error must be within kAmplifiedEstimate
+// (render/Truncation.h; assessStep): a hit of such a gain, where the ray
+// carried light, marks the pixel.
+void noteGain(inout SlotState state, vec3 gain, vec3 weight) {
+    if (AMPLIFYING && any(bvec3(uvec3(greaterThan(gain, vec3(1.0))) & uvec3(greaterThan(weight, vec3(0.0))))))
+        state.amplified = 1u;
+}
+
 // 4–5. The children of ray r at hit h: reflection (keeps the medium stack) and
-// refraction (SPEC §4.5). On return r is the child to trace next (hasRay), the
+// refraction (SPEC §4.5). Returns whether r is now a child to trace next, the
 // other child having been pushed on the stack; refraction is traced first, as
 // in the CPU reference. A child under the cut-off waits in the frontier
 // (deferRay); weight the depth limit stops is lost (render/Truncation.h).
-void spawnChildren(uint slot, inout SlotState state, inout Ray r, vec3 weight, Hit h, float cutOff,
-                   out bool hasRay) {
-    hasRay = false;
+bool spawnChildren(uint slot, inout SlotState state, inout Ray r, vec3 weight, Hit h, float cutOff) {
     vec3 reflectedGain = HAS_REFLECTION ? h.ks.rgb : vec3(0.0);
     if (r.depth >= frame.maxDepth) {
         state.lost.rgb += weighted(weight, reflectedGain + (HAS_REFRACTION ? h.kt.rgb : vec3(0.0)));
-        return;
+        return false;
     }
     rvec3 d = r.dir;
     rvec3 n = h.normal;
-    // Light carried into a material of ks + kt > 1 (SPEC §4 amplifying
-    // materials) can grow: an orbit of total internal reflection repeats its
-    // angle for ever, and a path of tiny weight that enters one grows until
-    // its channel saturates. The pixel's series may diverge behind steps that
-    // seem to settle, so its estimated error must be within kAmplifiedEstimate
-    // (render/Truncation.h; main).
-    if (AMPLIFYING && any(bvec3(uvec3(greaterThan(reflectedGain + (HAS_REFRACTION ? h.kt.rgb : vec3(0.0)), vec3(1.0))) &
-                                uvec3(greaterThan(weight, vec3(0.0))))))
-        state.amplified = 1u;
+    noteGain(state, reflectedGain + (HAS_REFRACTION ? h.kt.rgb : vec3(0.0)), weight);
     vec3 reflectedWeight = min(weighted(weight, reflectedGain), vec3(MAX_WEIGHT));
     bool transmits = false;  // a refracted ray exists (no total internal reflection)
     rvec3 refracted = rvec3(0.0);
@@ -552,24 +580,8 @@ void spawnChildren(uint slot, inout SlotState state, inout Ray r, vec3 weight, H
     vec4 kt = h.kt;
     if (HAS_REFRACTION && max(kt.r, max(kt.g, kt.b)) > 0.0) {
         transmittedWeight = min(weighted(weight, kt.rgb), vec3(MAX_WEIGHT));
-        real etaI, etaT;
-        if (h.fromOutside) {
-            // Entering: from the current medium into this sphere.
-            etaI = r.mediaCount == 0u ? frame.background.w : etaOfSphere(mediumAt(r.mediaCount - 1u));
-            etaT = kt.w;
-        } else {
-            // Leaving: into the medium that remains once this sphere is removed
-            // from the stack (its innermost occurrence; none: nothing removed).
-            etaI = kt.w;
-            [[unroll]] for (int k = 0; k < MAX_MEDIA; ++k)
-                if (uint(k) < r.mediaCount && media[k] == h.sphere) removeAt = uint(k);
-            uint innermost = NONE;  // the innermost one that stays
-            [[unroll]] for (int k = 0; k < MAX_MEDIA; ++k)
-                if (uint(k) < r.mediaCount && uint(k) != removeAt) innermost = media[k];
-            etaT = innermost == NONE ? frame.background.w : etaOfSphere(innermost);
-        }
         // Snell's law, SPEC §4.5.
-        real eta = etaI / etaT;
+        real eta = relativeIndex(r, h, removeAt);
         real c = -dot(n, d);
         real k = 1.0 - eta * eta * (1.0 - c * c);
         if (k < 0.0) {
@@ -591,8 +603,7 @@ void spawnChildren(uint slot, inout SlotState state, inout Ray r, vec3 weight, H
     if (refracts && COUNT_RAYS) countedRays[SNELL_COUNTER_REFRACTED]++;
     if (!transmits) {
         r = reflectedRay;
-        hasRay = reflects;
-        return;
+        return reflects;
     }
     // Both children: the lighter is traced next and the heavier waits on the
     // stack, so each waiting ray at least halves (ks + kt <= 1) the weight of
@@ -617,25 +628,11 @@ void spawnChildren(uint slot, inout SlotState state, inout Ray r, vec3 weight, H
     // reflected ray goes on with it).
     uint parentMedia[MAX_MEDIA];
     [[unroll]] for (int k = 0; k < MAX_MEDIA; ++k) parentMedia[k] = media[k];
-    uint count = r.mediaCount;
-    if (h.fromOutside) {
-        if (count == uint(MAX_MEDIA)) {  // deeper than the scene can nest: forget the outermost
-            [[unroll]] for (int k = 0; k + 1 < MAX_MEDIA; ++k) media[k] = media[k + 1];
-            count--;
-        }
-        [[unroll]] for (int k = 0; k < MAX_MEDIA; ++k)
-            if (uint(k) == count) media[k] = h.sphere;
-        count++;
-    } else if (removeAt < count) {
-        [[unroll]] for (int k = 0; k + 1 < MAX_MEDIA; ++k)
-            if (uint(k) >= removeAt && uint(k) + 1u < count) media[k] = media[k + 1];
-        count--;
-    }
+    uint count = crossSurface(h, r.mediaCount, removeAt);
     Ray refractedRay = Ray(h.point, refracted, transmittedWeight, r.depth + 1u, h.sphere, h.fromOutside, count, 0u);
     if (refracts && !refractedWaits) {
         r = refractedRay;  // traced next, with its medium stack
-        hasRay = true;
-        return;
+        return true;
     }
     if (!refracts) deferRay(slot, state, refractedRay);
     else if (stackFull) state.lost.rgb += transmittedWeight;
@@ -643,7 +640,7 @@ void spawnChildren(uint slot, inout SlotState state, inout Ray r, vec3 weight, H
     // The reflected ray goes on (if it is traced at all), with the parent's media.
     [[unroll]] for (int k = 0; k < MAX_MEDIA; ++k) media[k] = parentMedia[k];
     r = reflectedRay;
-    hasRay = reflects;
+    return reflects;
 }
 
 // SPEC §3: sub-pixel sample k of pixel p: the ray through
@@ -662,20 +659,123 @@ Ray cameraRay(uvec2 p, uint k) {
     return Ray(primaryStart.xyz + primaryStart.w * dir, dir, vec3(1.0), 0u, NONE, false, 0u, 0u);
 }
 
-void main() {
-    uint slot = gl_GlobalInvocationID.x;
-    uint slots = gl_NumWorkGroups.x * uint(SNELL_WORKGROUP_SIZE);
-    invocations = slots;
-    uint tilePixels = tile.width * tile.height;
-    [[unroll]] for (int k = 0; k < SNELL_RAY_COUNTER_COUNT; ++k) countedRays[k] = 0u;
-    [[unroll]] for (uint i = 0u; i < SPHERE_COUNT; ++i) {
-        preloadedAnchor[i] = sphereAnchor(i);
-        preloadedNormal[i] = sphereNormal(i);
-    }
+// ---------------------------------------------------------------------------
+// The pixel loop's steps. What a dispatch fixes for all of them, set once at
+// the start of main:
+uint tilePixels;     // the tile's pixels
+float tolerance;     // on each pixel's truncation bound; 0: a fixed tree
+float floorCutOff;   // the lowest cut-off (the fixed tree's cut-off without a tolerance)
+float firstCutOff;   // a pixel's first step's
+uint samples;        // sub-pixel samples a pixel traces
+uint pixelBudget;    // rays a pixel's trees may trace; 0: no limit
+float saturation;    // a channel's sum where it is final (amplifying scenes)
 
-    // This invocation's progress: its current pixel, that pixel's sum, and the
-    // rays on its stack and in its frontier. Fresh, or resumed from the last
-    // dispatch.
+SlotState freshPixel(uint pixelIndex) {
+    return SlotState(vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0), vec4(INFINITY), vec4(0.0), pixelIndex, 0u, 0u, 0u,
+                     0u, 0u, 0u, 0u, 0u, 0u, 0u, 0u, firstCutOff, 0.0, INFINITY, INFINITY, 0.0, 0u, 0u, 0u);
+}
+
+// What a finished step proves of its pixel (addStep, estimateError).
+struct StepOutcome {
+    float bound;     // on the clamped colour's truncation error
+    bool unbounded;  // no finite bound: light of a gain >= 1 was left
+    float estimate;  // the estimated error where unbounded
+    bool certified;  // bound within the tolerance
+    bool settled;    // stopped on its estimate instead
+};
+
+StepOutcome assessStep(inout SlotState state) {
+    StepOutcome o;
+    // (SPEC §3 mean, clamped on output.)
+    o.bound = addStep(state, float(samples), o.unbounded);
+    o.estimate = estimateError(state, float(samples));
+    o.certified = o.bound <= tolerance;
+    o.settled = frame.estimate != 0u && o.unbounded && o.estimate <= tolerance &&
+                (state.amplified == 0u || o.estimate <= frame.amplifiedEstimate);
+    return o;
+}
+
+// The cut-off of the pixel's next step, or 0 where it is finished. The next
+// rung: four below the heaviest ray this step left (render/RenderRequest.h,
+// nextRung), not under the floor; but a pixel whose trees gained weight goes
+// on below it, until its diverging channels saturate or its trees reach the
+// budget (SPEC §4 amplifying materials; as CpuRenderer::renderPixel does).
+float nextCutOff(SlotState state, StepOutcome o) {
+    float heaviest = state.heaviestLeft;
+    if (!(tolerance > 0.0) || o.certified || o.settled || !(heaviest > 0.0) || state.overBudget != 0u) return 0.0;
+    bool belowFloor = AMPLIFYING && o.unbounded && state.amplified != 0u && pixelBudget != 0u;
+    float next = cutOffRung(heaviest) / 16.0;
+    if (!belowFloor) next = max(floorCutOff, next);
+    return next <= heaviest ? next : 0.0;
+}
+
+// The next step traces on from the rays this one left in the frontier.
+void beginStep(inout SlotState state) {
+    state.deferred.rgb = vec3(0.0);
+    state.heaviestLeft = 0.0;
+    state.frontierOld = state.frontierCount;
+}
+
+// The finished pixel written out (render/Truncation.h: its colour, bound and
+// how it stopped), and the invocation moved on to its next pixel.
+void finishPixel(uint slot, inout SlotState state, StepOutcome o, uint shadowRays) {
+    bool overTolerance = tolerance > 0.0 && !o.certified && !o.settled;
+    outputPixels[state.pixel] = OutputPixel(
+        vec4(state.lower.rgb, o.unbounded ? -o.bound : o.bound),
+        vec4(o.settled ? o.estimate : -1.0, float(state.overBudget), overTolerance ? 1.0 : 0.0, 0.0));
+    uint finished = state.finished + 1u;
+    uint rays = state.rays;
+    state = freshPixel(state.pixel + invocations);
+    state.finished = finished;
+    state.rays = rays;
+    slotStates[slot].finished = finished;
+    slotStates[slot].rays = rays + shadowRays;
+}
+
+// The pixel's step has no ray left: on at a lower cut-off (cutOff), or the
+// pixel is finished and the invocation moves to its next one (pixel, within
+// the tile). Returns whether the invocation is done with the tile.
+bool endStep(uint slot, inout SlotState state, inout uvec2 pixel, inout float cutOff, uint shadowRays) {
+    StepOutcome outcome = assessStep(state);
+    float next = nextCutOff(state, outcome);
+    if (next > 0.0) {
+        cutOff = next;
+        beginStep(state);
+        return false;
+    }
+    finishPixel(slot, state, outcome, shadowRays);
+    pixel += uvec2(tile.stepX, tile.stepY);
+    if (pixel.x >= tile.width) pixel += uvec2(-tile.width, 1u);
+    cutOff = firstCutOff;
+    return state.pixel >= tilePixels;
+}
+
+// The next ray of the pixel's current step: a child waiting on the stack,
+// else a ray the last step left in the frontier, else a camera ray for its
+// next sample. False where the step has none left.
+bool nextRay(uint slot, inout SlotState state, uvec2 pixel, out Ray ray) {
+    if (state.pending > 0u) {
+        ray = popRay(slot, state.pending);
+        return true;
+    }
+    if (state.frontierOld > 0u) {
+        ray = loadRay(frontierEntry(slot, state.frontierHead));
+        state.frontierHead = (state.frontierHead + 1u) % max(FRONTIER, 1u);
+        state.frontierCount--;
+        state.frontierOld--;
+        return true;
+    }
+    if (state.started < samples) {
+        ray = cameraRay(pixel + uvec2(tile.originX, tile.originY), frame.firstSample + state.started);
+        state.started++;
+        if (COUNT_RAYS) countedRays[SNELL_COUNTER_PRIMARY]++;
+        return true;
+    }
+    return false;
+}
+
+// The dispatch's constants (above) from the frame.
+void setDispatchConstants() {
     // Mesa 22.3's lavapipe specialises a shader on values it reads from
     // uniforms with constant offsets where it judges that worthwhile
     // (lvp_inline_uniforms); for this kernel it judged so because of the
@@ -684,27 +784,114 @@ void main() {
     // cannot see as uniform (dispatches are one row of workgroups) keeps the
     // tolerance out of that analysis; tests/soak_test.sh watches for it.
     uint opaqueZero = gl_NumWorkGroups.y - 1u;
-    float tolerance = frame.radiance.w + float(opaqueZero);
-    float floorCutOff = frame.ambient.w;
+    tolerance = frame.tolerance + float(opaqueZero);
+    floorCutOff = frame.minWeight;
     // Under a tolerance each pixel starts on the ladder's first rung, 1/4,
     // whatever the tolerance (render/RenderRequest.h, kFirstRung).
-    float firstCutOff = tolerance > 0.0 ? max(floorCutOff, 0.25) : floorCutOff;
-    const SlotState freshPixel = SlotState(vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0), vec4(INFINITY), vec4(0.0),
-                                           vec4(firstCutOff, 0.0, INFINITY, INFINITY), 0u, 0u, 0u, 0u, 0u, 0u, 0u,
-                                           0u, 0u, 0u, 0u, 0u);
-    SlotState state = freshPixel;
-    state.pixel = slot;
+    firstCutOff = tolerance > 0.0 ? max(floorCutOff, 0.25) : floorCutOff;
+    samples = frame.sampleCount;
+    pixelBudget = frame.treeBudget * samples;
+    // SPEC §4 amplifying materials: a channel whose pixel sum has reached 1
+    // (times the samples, as the sum is of samples) is final in 8 bits.
+    saturation = AMPLIFYING ? float(samples) : 3.0e38;
+}
+
+// 1–2. Ray r of the pixel: under the cut-off it waits in the frontier, past
+// the tree budget it is lost; else its closest hit, with the background on a
+// miss or the ambient term on a hit added to the pixel. True where it hit
+// (h, and the weight it carries), to be shaded. A ray that resumes shading
+// keeps the weight it started with and adds nothing twice.
+bool traceRay(uint slot, inout SlotState state, inout Ray r, float cutOff, out vec3 weight, out Hit h,
+              inout uint deepest) {
+    weight = r.weight;
+    bool resuming = r.resumeShading != 0u;
+    if (AMPLIFYING && !resuming) weight = mix(weight, vec3(0.0), greaterThanEqual(state.sum.rgb, vec3(saturation)));
+    if (!resuming && !worthTracing(weight, tracingCutOff(state, cutOff))) {
+        r.weight = weight;
+        deferRay(slot, state, r);
+        return false;
+    }
+    // The pixel's trees past the budget: the rest of them is lost.
+    if (!resuming && pixelBudget != 0u && state.treeRays >= pixelBudget) {
+        state.overBudget = 1u;
+        state.lost.rgb += weight;
+        return false;
+    }
+    if (!resuming) {
+        state.treeRays++;
+        state.rays++;
+    }
+    vec3 sum = state.sum.rgb;
+    bool hit = findHit(r, weight, sum, h);
+    if (hit && !resuming) sum += weighted(weight, frame.ambient.rgb * h.kd.rgb);
+    state.sum.rgb = sum;
+    deepest = max(deepest, r.depth);
+    return hit;
+}
+
+// 3. The lights' part of the local term of ray r at hit h, each light added
+// to the pixel as it is shaded, in light order (the same sums whether or not
+// shading is suspended part-way). Under a loop budget every lane runs this
+// loop (shading or not), so the subgroup can check its budget between lights:
+// one ray's shading may take any number of lights, over several dispatches.
+// Rays that resume start where they stopped: the loop starts at the first
+// light some lane still needs, so every dispatch moves on. Returns true where
+// the budget suspended it (r then waits to resume at the next light).
+bool shadeLights(inout SlotState state, inout Ray r, vec3 weight, Hit h, bool shading, inout uint shadowRays) {
+    if (!HAS_LIGHTS || !(shading || LOOP_BUDGET != 0u)) return false;
+    rvec3 v = -r.dir;
+    uint firstLight = LOOP_BUDGET != 0u ? subgroupMin(shading ? max(r.resumeShading, 1u) - 1u : frame.lightCount) : 0u;
+    for (uint j = firstLight; j < frame.lightCount; ++j) {
+        // At least one light a dispatch, whatever the hit cost: progress.
+        if (j > firstLight && loopBudgetSpent()) {
+            if (shading) {
+                r.resumeShading = max(r.resumeShading, j + 1u);
+                r.weight = weight;
+            }
+            return true;
+        }
+        tick(2u);  // this light, and the occlusion loop should no lane enter it
+        if (shading && j + 1u >= r.resumeShading) state.sum.rgb += weighted(weight, shadeLight(j, h, v, shadowRays));
+    }
+    return false;
+}
+
+// This invocation's counts into the dispatch's counters (read by the host).
+void addCounters(uint deepest) {
+    if (deepest > 0u) atomicMax(counters[SNELL_COUNTER_DEEPEST], deepest);
+    if (COUNT_RAYS) {
+        [[unroll]] for (int k = 0; k < SNELL_RAY_COUNTER_COUNT; ++k)
+            if (countedRays[k] != 0u) atomicAdd(counters[k], countedRays[k]);
+    }
+    if (COUNT_LANES) {
+        if (traceSlots != 0u) atomicAdd(counters[SNELL_COUNTER_TRACE_SLOTS], traceSlots);
+        if (traceBusy != 0u) atomicAdd(counters[SNELL_COUNTER_TRACE_BUSY], traceBusy);
+        if (walkSlots != 0u) atomicAdd(counters[SNELL_COUNTER_WALK_SLOTS], walkSlots);
+        if (walkBusy != 0u) atomicAdd(counters[SNELL_COUNTER_WALK_BUSY], walkBusy);
+    }
+}
+
+void main() {
+    uint slot = gl_GlobalInvocationID.x;
+    invocations = gl_NumWorkGroups.x * uint(SNELL_WORKGROUP_SIZE);
+    tilePixels = tile.width * tile.height;
+    [[unroll]] for (int k = 0; k < SNELL_RAY_COUNTER_COUNT; ++k) countedRays[k] = 0u;
+    [[unroll]] for (uint i = 0u; i < SPHERE_COUNT; ++i) {
+        preloadedAnchor[i] = sphereAnchor(i);
+        preloadedNormal[i] = sphereNormal(i);
+    }
+    setDispatchConstants();
+
+    // This invocation's progress: its current pixel, that pixel's sum, and the
+    // rays on its stack and in its frontier. Fresh, or resumed from the last
+    // dispatch.
+    SlotState state = freshPixel(slot);
     if (tile.resume != 0u) state = slotStates[slot];
-    float cutOff = state.cutOff.x;
+    float cutOff = state.cutOff;
     uint shadowRays = 0u;               // cast in this dispatch (for SlotState.rays)
     uint deepest = 0u;
     bool done = state.pixel >= tilePixels;
     uvec2 pixel = uvec2(state.pixel % tile.width, state.pixel / tile.width);  // within the tile
-    uint samples = frame.sampleCount;
-    uint pixelBudget = frame.treeBudget * samples;  // 0: none
-    // SPEC §4 amplifying materials: a channel whose pixel sum has reached 1
-    // (times the samples, as the sum is of samples) is final in 8 bits.
-    float saturation = AMPLIFYING ? float(samples) : 3.0e38;
 
     Ray ray;
     bool hasRay = false;
@@ -715,7 +902,7 @@ void main() {
     while (true) {
         if (LOOP_BUDGET != 0u) {
             if (subgroupAll(done)) break;
-            if (subgroupAdd(loopTicks) >= LOOP_BUDGET) {
+            if (loopBudgetSpent()) {
                 suspended = true;
                 break;
             }
@@ -734,130 +921,22 @@ void main() {
         }
         // A step of the pixel is finished when it has no ray left: what it
         // proves, and whether a lower cut-off is worth it (then the step goes
-        // on from the frontier in this very pass).
-        if (!done && !hasRay && state.pending == 0u && state.frontierOld == 0u && state.started == samples) {
-            // (SPEC §3 mean, clamped on output.)
-            bool unbounded;
-            float bound = addStep(state, float(samples), unbounded);
-            float estimate = estimateError(state, float(samples));
-            bool certified = bound <= tolerance;
-            bool settled = frame.estimate != 0u && unbounded && estimate <= tolerance &&
-                           (state.amplified == 0u || estimate <= frame.localRadiance.w);
-            // The next rung: four below the heaviest ray this step left
-            // (render/RenderRequest.h, nextRung), not under the floor; but a
-            // pixel whose trees gained weight goes on below it, until its
-            // diverging channels saturate or its trees reach the budget
-            // (SPEC §4 amplifying materials; as CpuRenderer::renderPixel does).
-            float heaviest = state.cutOff.y;
-            bool belowFloor = AMPLIFYING && unbounded && state.amplified != 0u && pixelBudget != 0u;
-            float next = cutOffRung(heaviest) / 16.0;
-            if (!belowFloor) next = max(floorCutOff, next);
-            if (tolerance > 0.0 && !certified && !settled && heaviest > 0.0 && next > 0.0 && next <= heaviest &&
-                state.overBudget == 0u) {
-                cutOff = next;
-                state.deferred.rgb = vec3(0.0);
-                state.cutOff.y = 0.0;
-                state.frontierOld = state.frontierCount;
-            } else {
-                bool overTolerance = tolerance > 0.0 && !certified && !settled;
-                outputPixels[state.pixel] = OutputPixel(
-                    vec4(state.lower.rgb, unbounded ? -bound : bound),
-                    vec4(settled ? estimate : -1.0, float(state.overBudget), overTolerance ? 1.0 : 0.0, 0.0));
-                uint finished = state.finished + 1u;
-                uint rays = state.rays;
-                uint nextPixel = state.pixel + slots;
-                state = freshPixel;
-                state.finished = finished;
-                state.rays = rays;
-                state.pixel = nextPixel;
-                slotStates[slot].finished = finished;
-                slotStates[slot].rays = rays + shadowRays;
-                pixel += uvec2(tile.stepX, tile.stepY);
-                if (pixel.x >= tile.width) pixel += uvec2(-tile.width, 1u);
-                cutOff = firstCutOff;
-                done = state.pixel >= tilePixels;
-            }
-        }
-        if (!done && !hasRay) {
-            if (state.pending > 0u) {
-                ray = popRay(slot, state.pending);
-                hasRay = true;
-            } else if (state.frontierOld > 0u) {
-                // This step goes on from a ray the last one left.
-                ray = loadRay(frontierEntry(slot, state.frontierHead));
-                state.frontierHead = (state.frontierHead + 1u) % max(FRONTIER, 1u);
-                state.frontierCount--;
-                state.frontierOld--;
-                hasRay = true;
-            } else if (state.started < samples) {
-                ray = cameraRay(pixel + uvec2(tile.originX, tile.originY), frame.firstSample + state.started);
-                state.started++;
-                hasRay = true;
-                if (COUNT_RAYS) countedRays[SNELL_COUNTER_PRIMARY]++;
-            }
-        }
-
+        // on from the frontier in this very pass), else the pixel is done.
+        if (!done && !hasRay && state.pending == 0u && state.frontierOld == 0u && state.started == samples)
+            done = endStep(slot, state, pixel, cutOff, shadowRays);
+        if (!done && !hasRay) hasRay = nextRay(slot, state, pixel, ray);
         if (COUNT_LANES) countLanes(hasRay, traceSlots, traceBusy);
         // Trace the ray in hand: closest hit, local term, children.
         vec3 weight = vec3(0.0);
         Hit h;
-        bool shading = false;
-        if (hasRay) {
-            weight = ray.weight;
-            bool resuming = ray.resumeShading != 0u;  // it keeps the weight it started with
-            if (AMPLIFYING && !resuming)
-                weight = mix(weight, vec3(0.0), greaterThanEqual(state.sum.rgb, vec3(saturation)));
-            // The pixel's trees past the budget: the rest of them is lost.
-            bool overBudget = pixelBudget != 0u && state.treeRays >= pixelBudget && !resuming;
-            if (!resuming && !worthTracing(weight, tracingCutOff(state, cutOff))) {
-                ray.weight = weight;
-                deferRay(slot, state, ray);
-            } else if (overBudget) {
-                state.overBudget = 1u;
-                state.lost.rgb += weight;
-            } else {
-                if (!resuming) {
-                    state.treeRays++;
-                    state.rays++;
-                }
-                vec3 sum = state.sum.rgb;
-                shading = findHit(ray, weight, sum, h);
-                // The ambient part once, not again when shading resumes.
-                if (shading && !resuming) sum += weighted(weight, frame.ambient.rgb * h.kd.rgb);
-                state.sum.rgb = sum;
-                deepest = max(deepest, ray.depth);
-            }
-            hasRay = shading;
+        bool shading = hasRay && traceRay(slot, state, ray, cutOff, weight, h, deepest);
+        hasRay = shading;
+        // 3. Lights (suspending shading part-way where the loop budget is spent).
+        if (shadeLights(state, ray, weight, h, shading, shadowRays)) {
+            suspended = true;
+            break;
         }
-        // 3. Lights, each added to the pixel as it is shaded, in light order
-        // (the same sums whether or not shading is suspended part-way).
-        rvec3 v = -ray.dir;
-        if (HAS_LIGHTS && LOOP_BUDGET == 0u && shading) {
-            for (uint j = 0u; j < frame.lightCount; ++j) state.sum.rgb += weighted(weight, shadeLight(j, h, v, shadowRays));
-        }
-        if (HAS_LIGHTS && LOOP_BUDGET != 0u) {
-            // Every lane runs this loop (it is not inside `if (shading)`), so the
-            // subgroup can check its budget between lights: one ray's shading
-            // may take any number of lights, over several dispatches.
-            // Rays that resume start where they stopped: the loop starts at the
-            // first light some lane still needs, so every dispatch moves on.
-            uint firstLight = subgroupMin(shading ? max(ray.resumeShading, 1u) - 1u : frame.lightCount);
-            for (uint j = firstLight; j < frame.lightCount; ++j) {
-                // At least one light a dispatch, whatever the hit cost: progress.
-                if (j > firstLight && subgroupAdd(loopTicks) >= LOOP_BUDGET) {
-                    suspended = true;
-                    if (shading) {
-                        ray.resumeShading = max(ray.resumeShading, j + 1u);  // the ray waits, to resume here
-                        ray.weight = weight;
-                    }
-                    break;
-                }
-                tick(2u);  // this light, and the occlusion loop should no lane enter it
-                if (shading && j + 1u >= ray.resumeShading) state.sum.rgb += weighted(weight, shadeLight(j, h, v, shadowRays));
-            }
-            if (suspended) break;
-        }
-        if (shading) spawnChildren(slot, state, ray, weight, h, cutOff, hasRay);
+        if (shading) hasRay = spawnChildren(slot, state, ray, weight, h, cutOff);
     }
 
     if (suspended) {
@@ -867,23 +946,9 @@ void main() {
     }
     // Under a loop budget the next dispatch resumes every invocation, those
     // whose subgroup finished included: each leaves its state, done or not.
-    state.cutOff.x = cutOff;
+    state.cutOff = cutOff;
     state.rays += shadowRays;
     if (LOOP_BUDGET != 0u) slotStates[slot] = state;
-    if (deepest > 0u) atomicMax(counters[SNELL_COUNTER_DEEPEST], deepest);
-    if (COUNT_RAYS) {
-        [[unroll]] for (int k = 0; k < SNELL_RAY_COUNTER_COUNT; ++k)
-            if (countedRays[k] != 0u) atomicAdd(counters[k], countedRays[k]);
-    }
-    if (COUNT_LANES) {
-        if (traceSlots != 0u) atomicAdd(counters[SNELL_COUNTER_TRACE_SLOTS], traceSlots);
-        if (traceBusy != 0u) atomicAdd(counters[SNELL_COUNTER_TRACE_BUSY], traceBusy);
-        if (walkSlots != 0u) atomicAdd(counters[SNELL_COUNTER_WALK_SLOTS], walkSlots);
-        if (walkBusy != 0u) atomicAdd(counters[SNELL_COUNTER_WALK_BUSY], walkBusy);
-    }
-    // Past the driver's limit some loop may have been cut short: say so.
-    if (LOOP_BUDGET != 0u) {
-        uint spent = subgroupAdd(loopTicks);  // all lanes take part
-        if (subgroupElect() && spent >= SNELL_DRIVER_LOOP_LIMIT) atomicAdd(counters[SNELL_COUNTER_LOOP_LIMIT], 1u);
-    }
+    addCounters(deepest);
+    reportLoopLimit();
 }

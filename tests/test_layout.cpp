@@ -70,7 +70,7 @@ std::uint32_t skipOf(const gpu::BvhNode& n) { return std::bit_cast<std::uint32_t
 std::uint32_t codeOf(const gpu::BvhNode& n) { return std::bit_cast<std::uint32_t>(n.upper.w); }
 
 TEST(Layout, FrameParams) {
-    EXPECT_EQ(sizeof(gpu::FrameParams), 176u);
+    EXPECT_EQ(sizeof(gpu::FrameParams), 192u);
     EXPECT_EQ(offsetof(gpu::FrameParams, primaryStart), 0u);
     EXPECT_EQ(offsetof(gpu::FrameParams, cornerDir), 16u);
     EXPECT_EQ(offsetof(gpu::FrameParams, pixelRight), 32u);
@@ -88,6 +88,12 @@ TEST(Layout, FrameParams) {
     EXPECT_EQ(offsetof(gpu::FrameParams, bvhNodeCount), 152u);
     EXPECT_EQ(offsetof(gpu::FrameParams, firstSample), 156u);
     EXPECT_EQ(offsetof(gpu::FrameParams, sampleCount), 160u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, treeBudget), 164u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, estimate), 168u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, minWeight), 172u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, tolerance), 176u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, amplifiedEstimate), 180u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, airEta), 184u);
 }
 
 TEST(Layout, TileParams) {
@@ -102,15 +108,20 @@ TEST(Layout, TileParams) {
 }
 
 TEST(Layout, SlotStateAndPendingRay) {
-    EXPECT_EQ(sizeof(gpu::SlotState), 160u);
+    EXPECT_EQ(sizeof(gpu::SlotState), 176u);
     EXPECT_EQ(offsetof(gpu::SlotState, deferred), 16u);
     EXPECT_EQ(offsetof(gpu::SlotState, lower), 48u);
     EXPECT_EQ(offsetof(gpu::SlotState, settled), 80u);
-    EXPECT_EQ(offsetof(gpu::SlotState, cutOff), 96u);
-    EXPECT_EQ(offsetof(gpu::SlotState, pixel), 112u);
-    EXPECT_EQ(offsetof(gpu::SlotState, finished), 124u);
-    EXPECT_EQ(offsetof(gpu::SlotState, treeRays), 128u);
-    EXPECT_EQ(offsetof(gpu::SlotState, frontierHead), 144u);
+    EXPECT_EQ(offsetof(gpu::SlotState, pixel), 96u);
+    EXPECT_EQ(offsetof(gpu::SlotState, finished), 108u);
+    EXPECT_EQ(offsetof(gpu::SlotState, treeRays), 112u);
+    EXPECT_EQ(offsetof(gpu::SlotState, frontierHead), 128u);
+    EXPECT_EQ(offsetof(gpu::SlotState, amplified), 140u);
+    EXPECT_EQ(offsetof(gpu::SlotState, cutOff), 144u);
+    EXPECT_EQ(offsetof(gpu::SlotState, heaviestLeft), 148u);
+    EXPECT_EQ(offsetof(gpu::SlotState, lastMove), 152u);
+    EXPECT_EQ(offsetof(gpu::SlotState, moveBefore), 156u);
+    EXPECT_EQ(offsetof(gpu::SlotState, settledWeight), 160u);
     EXPECT_EQ(sizeof(gpu::OutputPixel), 32u);
     EXPECT_EQ(offsetof(gpu::OutputPixel, truncation), 16u);
     EXPECT_EQ(sizeof(gpu::PendingRay), 64u);
@@ -203,7 +214,17 @@ TEST(GpuScene, SmallSceneIsOriginRelativeAndClassified) {
     EXPECT_FLOAT_EQ(g.lights[0].colour.r, 0.7f);
     EXPECT_FLOAT_EQ(g.lights[0].colour.b, 0.9f);
 
-    const gpu::FrameParams f = gpu::makeFrameParams(s, g, camera, 10, 10, 1, 0, 0, {.maxDepth = 32, .minWeight = 1e-4});
+    snell::RenderRequest request;
+    request.camera = camera;
+    request.width = request.height = 10;
+    request.trace = {.maxDepth = 32, .minWeight = 1e-4, .tolerance = 0.002};
+    const gpu::FrameParams f = gpu::makeFrameParams(s, g, request);
+    EXPECT_EQ(f.maxDepth, 32u);
+    EXPECT_FLOAT_EQ(f.minWeight, 1e-4f);
+    EXPECT_FLOAT_EQ(f.tolerance, 0.002f);
+    EXPECT_FLOAT_EQ(f.airEta, static_cast<float>(snell::kAirEta));
+    EXPECT_EQ(f.supersample, 1u);
+    EXPECT_EQ(f.sampleCount, 1u);
     EXPECT_EQ(f.sphereCount, 2u);
     EXPECT_EQ(f.lightCount, 1u);
     EXPECT_EQ(f.bvhNodeCount, 0u);

@@ -352,285 +352,333 @@ std::vector<PixelWindow> ComputeRenderer::tiles(const PixelWindow& area) {
     return out;
 }
 
+// How render() covers its window: square tiles of at most kMaxTileSide (16 MiB
+// of float image), each traced by the same persistent invocations.
+struct ComputeRenderer::TilePlan {
+    PixelWindow area;  // the window rendered; pixel coordinates stay the whole image's
+    int tileWidth = 0, tileHeight = 0, tilesX = 0, tilesY = 0;
+    VkDeviceSize invocations = 0;
+
+    int count() const { return tilesX * tilesY; }
+    VkDeviceSize tilePixels() const { return VkDeviceSize(tileWidth) * tileHeight; }
+    // Tile (tx, ty): where it is, and how an invocation steps through it.
+    gpu::TileParams tile(int tx, int ty) const {
+        gpu::TileParams t{};
+        t.originX = std::uint32_t(area.x0 + tx * tileWidth);
+        t.originY = std::uint32_t(area.y0 + ty * tileHeight);
+        t.width = std::uint32_t(std::min(tileWidth, area.width() - tx * tileWidth));
+        t.height = std::uint32_t(std::min(tileHeight, area.height() - ty * tileHeight));
+        t.stepX = std::uint32_t(invocations % t.width);
+        t.stepY = std::uint32_t(invocations / t.width);
+        return t;
+    }
+};
+
+// A render in progress: the dispatches' times, the tiles finished and their
+// rays (the tile in progress adds its invocations' counts), the truncation.
+struct ComputeRenderer::Progress {
+    double hostMs = 0.0, gpuMs = 0.0;
+    std::uint64_t raysBefore = 0;
+    int tilesDone = 0;
+    TruncationReport truncation;
+    // While a dispatch runs the host wakes a few times a second for this:
+    // progress read from the invocations' states, and Ctrl-C.
+    std::function<void()> whileRunning;
+};
+
+ComputeRenderer::TilePlan ComputeRenderer::planTiles(const RenderRequest& request,
+                                                     const Specialisation& values) const {
+    TilePlan plan;
+    plan.area = request.area();
+    plan.tileWidth = std::min(kMaxTileSide, plan.area.width());
+    plan.tileHeight = std::min(kMaxTileSide, plan.area.height());
+    plan.tilesX = (plan.area.width() + plan.tileWidth - 1) / plan.tileWidth;
+    plan.tilesY = (plan.area.height() + plan.tileHeight - 1) / plan.tileHeight;
+    // Persistent invocations (trace.comp): on a CPU device a few workgroups
+    // per core keep every core busy to the end of the dispatch; on a GPU
+    // one per pixel, as many as the memory for their ray stacks allows.
+    const bool wide = layout_.precision == gpu::Precision::Fp64;  // a low part per pending ray too
+    const VkDeviceSize rayEntries = VkDeviceSize(values[SNELL_SPEC_RAY_STACK]) + values[SNELL_SPEC_FRONTIER];
+    const VkDeviceSize bytesPerSlot =
+        sizeof(gpu::SlotState) +
+        rayEntries * ((wide ? 2 : 1) * sizeof(gpu::PendingRay) + values[SNELL_SPEC_MAX_MEDIA] * 4);
+    const VkDeviceSize limit = context_.properties().limits.maxStorageBufferRange;
+    VkDeviceSize slots = std::min(kStackBudget, limit) / bytesPerSlot;
+    if (context_.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU)
+        slots = std::min<VkDeviceSize>(slots, SNELL_WORKGROUP_SIZE * kCpuWorkgroupsPerCore *
+                                                  std::max(1u, std::thread::hardware_concurrency()));
+    plan.invocations =
+        std::clamp<VkDeviceSize>(std::min(slots, plan.tilePixels()) / SNELL_WORKGROUP_SIZE, 1, 65535) *
+        SNELL_WORKGROUP_SIZE;
+    return plan;
+}
+
+ComputeRenderer::Pipeline& ComputeRenderer::ensurePipeline(const Specialisation& values, bool& created) {
+    // The pipeline of the last render serves again when the specialisation
+    // is the same, and its buffers when they are large enough (the preview).
+    created = !cached_ || cached_->values != values;
+    if (!created) return *cached_;
+    if (cached_) destroyPipeline(*cached_);
+    cached_ = std::make_unique<Pipeline>();
+    createPipeline(values, *cached_);
+    cached_->counters = context_.createBuffer(SNELL_COUNTER_COUNT * sizeof(std::uint32_t), kStorage, true);
+    return *cached_;
+}
+
+void ComputeRenderer::ensureBuffers(Pipeline& p, const RenderRequest& request, const TilePlan& plan) {
+    const bool wide = layout_.precision == gpu::Precision::Fp64;
+    gpu::FrameParams frameLow{};
+    const gpu::FrameParams frame = gpu::makeFrameParams(scene_, layout_, request, &frameLow);
+    context_.destroy(p.frame);
+    context_.destroy(p.frameLow);
+    p.frame = context_.createBufferWithData(&frame, sizeof frame, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
+    if (wide) p.frameLow = context_.createBufferWithData(&frameLow, sizeof frameLow, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
+    if (plan.invocations > p.slots) {
+        for (vk::Buffer* b : {&p.slotStates, &p.rayStack, &p.mediaStack, &p.rayStackLow}) context_.destroy(*b);
+        const VkDeviceSize slots = plan.invocations;
+        p.slots = slots;
+        // Host-visible: the host reads the invocations' progress while they run.
+        p.slotStates = context_.createBuffer(slots * sizeof(gpu::SlotState), kStorage, true);
+        p.rayStack = context_.createBuffer(slots * p.rayEntries * sizeof(gpu::PendingRay), kStorage, false);
+        p.mediaStack = context_.createBuffer(slots * p.rayEntries * p.maxMedia * 4, kStorage, false);
+        if (wide) p.rayStackLow = context_.createBuffer(slots * p.rayEntries * sizeof(gpu::PendingRay), kStorage, false);
+    }
+    if (plan.tilePixels() > p.tilePixels) {
+        context_.destroy(p.output);
+        p.tilePixels = plan.tilePixels();
+        // The tile's pixels, which the host reads where the shader wrote them
+        // (on lavapipe, an imageStore in a loop costs 13x a buffer store).
+        p.output = context_.createBuffer(p.tilePixels * sizeof(gpu::OutputPixel), kStorage, true);
+    }
+
+    std::array<VkDescriptorBufferInfo, SNELL_BINDING_COUNT> bufferInfo{};
+    std::array<const vk::Buffer*, SNELL_BINDING_COUNT> buffers{};
+    buffers[SNELL_BINDING_OUTPUT] = &p.output;
+    buffers[SNELL_BINDING_FRAME] = &p.frame;
+    buffers[SNELL_BINDING_COUNTERS] = &p.counters;
+    buffers[SNELL_BINDING_SLOT_STATES] = &p.slotStates;
+    buffers[SNELL_BINDING_RAY_STACK] = &p.rayStack;
+    buffers[SNELL_BINDING_MEDIA_STACK] = &p.mediaStack;
+    buffers[SNELL_BINDING_FRAME_LOW] = &p.frameLow;
+    buffers[SNELL_BINDING_RAY_STACK_LOW] = &p.rayStackLow;
+    std::array<VkWriteDescriptorSet, SNELL_BINDING_COUNT> writes{};
+    for (std::uint32_t i = 0; i < p.bindingCount; ++i) {
+        writes[i] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+        writes[i].dstSet = p.set;
+        writes[i].dstBinding = i;
+        writes[i].descriptorCount = 1;
+        writes[i].descriptorType = descriptorType(i);
+        if (writes[i].descriptorType == VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER) {
+            writes[i].pTexelBufferView = &sceneViews_[i];
+        } else {
+            if (!buffers[i]) buffers[i] = &sceneBuffers_[i];
+            bufferInfo[i] = {buffers[i]->buffer, 0, VK_WHOLE_SIZE};
+            writes[i].pBufferInfo = &bufferInfo[i];
+        }
+    }
+    vkUpdateDescriptorSets(context_.device(), p.bindingCount, writes.data(), 0, nullptr);
+}
+
+// Record one command buffer (`resumes`: after a barrier on the last
+// dispatch's invocation states and stacks; then `record`, timed when asked),
+// submit it and wait, calling progress.whileRunning while it runs.
+void ComputeRenderer::submit(Pipeline& p, Progress& progress, bool timed, bool resumes,
+                             const std::function<void(VkCommandBuffer)>& record) {
+    VkDevice device = context_.device();
+    VkCommandBuffer cmd = p.commands;
+    check(vkResetCommandBuffer(cmd, 0), "vkResetCommandBuffer");
+    VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
+    begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
+    check(vkBeginCommandBuffer(cmd, &begin), "vkBeginCommandBuffer");
+    if (resumes)
+        memoryBarrier(cmd, VK_ACCESS_SHADER_WRITE_BIT, VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT,
+                      VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
+    if (timed && p.queries) {
+        vkCmdResetQueryPool(cmd, p.queries, 0, 2);
+        vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, p.queries, 0);
+    }
+    record(cmd);
+    if (timed && p.queries) vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, p.queries, 1);
+    check(vkEndCommandBuffer(cmd), "vkEndCommandBuffer");
+    const auto start = Clock::now();
+    VkSubmitInfo info{VK_STRUCTURE_TYPE_SUBMIT_INFO};
+    info.commandBufferCount = 1;
+    info.pCommandBuffers = &cmd;
+    check(context_.submit(info, p.fence), "vkQueueSubmit");
+    for (;;) {
+        constexpr std::uint64_t kPollNs = 100'000'000;
+        const VkResult waited =
+            vkWaitForFences(device, 1, &p.fence, VK_TRUE, progress.whileRunning ? kPollNs : UINT64_MAX);
+        if (waited != VK_TIMEOUT) {
+            check(waited, "vkWaitForFences");
+            break;
+        }
+        progress.whileRunning();
+    }
+    check(vkResetFences(device, 1, &p.fence), "vkResetFences");
+    if (!timed) return;
+    progress.hostMs += msSince(start);
+    if (p.queries) {
+        std::uint64_t stamps[2] = {0, 0};
+        check(vkGetQueryPoolResults(device, p.queries, 0, 2, sizeof stamps, stamps, sizeof(std::uint64_t),
+                                    VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
+              "vkGetQueryPoolResults");
+        progress.gpuMs += double(stamps[1] - stamps[0]) * context_.properties().limits.timestampPeriod * 1e-6;
+    }
+}
+
+// An empty dispatch: llvmpipe compiles a shader at its first dispatch, and
+// that belongs to pipeline creation, not to the render.
+void ComputeRenderer::firstDispatch(Pipeline& p) {
+    const gpu::TileParams empty{};
+    std::memset(p.counters.mapped, 0, SNELL_COUNTER_COUNT * sizeof(std::uint32_t));
+    Progress untimed;
+    submit(p, untimed, false, false, [&](VkCommandBuffer cmd) {
+        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.pipeline);
+        vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.layout, 0, 1, &p.set, 0, nullptr);
+        vkCmdPushConstants(cmd, p.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof empty, &empty);
+        vkCmdDispatch(cmd, 1, 1, 1);
+    });
+}
+
+// The request's progress callback: finished tiles plus the share of the
+// current tile's pixels its invocations finished, and the rays so far.
+void ComputeRenderer::reportProgress(const Pipeline& p, const RenderRequest& request, const TilePlan& plan,
+                                     const gpu::TileParams& tile, Progress& progress, bool tileDone) const {
+    const auto* states = static_cast<const gpu::SlotState*>(p.slotStates.mapped);
+    std::uint64_t finished = 0, rays = progress.raysBefore;
+    for (VkDeviceSize k = 0; k < plan.invocations; ++k) {
+        finished += states[k].finished;
+        rays += states[k].rays;
+    }
+    if (request.progress)
+        request.progress((progress.tilesDone + double(finished) / double(tile.width * tile.height)) / plan.count(),
+                         rays);
+    if (tileDone) progress.raysBefore = rays;
+}
+
+// One tile: a dispatch traces it; where the driver limits loops, the
+// invocations suspend and the next dispatch resumes them, until none is left
+// unfinished. Adds the counters to `result`.
+void ComputeRenderer::dispatchTile(Pipeline& p, const RenderRequest& request, const TilePlan& plan,
+                                   gpu::TileParams tile, bool countRays, Progress& progress, GpuRenderResult& result) {
+    auto* counters = static_cast<std::uint32_t*>(p.counters.mapped);
+    const std::uint32_t groups = std::uint32_t(plan.invocations / SNELL_WORKGROUP_SIZE);
+    progress.whileRunning = [&] {
+        if (request.cancel && request.cancel->load())
+            std::atomic_ref<std::uint32_t>(counters[SNELL_COUNTER_CANCEL]).store(1u);
+        reportProgress(p, request, plan, tile, progress, false);
+    };
+    for (int pass = 0;; ++pass) {
+        if (request.cancel && request.cancel->load()) throw vk::VulkanError("render cancelled");
+        std::memset(counters, 0, SNELL_COUNTER_COUNT * sizeof(std::uint32_t));
+        tile.resume = pass > 0 ? 1u : 0u;
+        if (pass == 0) std::memset(p.slotStates.mapped, 0, plan.invocations * sizeof(gpu::SlotState));
+        submit(p, progress, true, pass > 0, [&](VkCommandBuffer cmd) {
+            vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.pipeline);
+            vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.layout, 0, 1, &p.set, 0, nullptr);
+            vkCmdPushConstants(cmd, p.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof tile, &tile);
+            vkCmdDispatch(cmd, groups, 1, 1);
+            memoryBarrier(cmd, VK_ACCESS_SHADER_WRITE_BIT, VK_ACCESS_HOST_READ_BIT,
+                          VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT);
+        });
+        ++result.dispatches;
+        if (counters[SNELL_COUNTER_LOOP_LIMIT] != 0)
+            throw vk::VulkanError("a single ray needed more loop iterations than lavapipe allows in one "
+                                  "dispatch (65535 per SIMD row); the image would be wrong. Try fewer "
+                                  "lights or a smaller --depth");
+        progress.truncation.deepest = std::max(progress.truncation.deepest, int(counters[SNELL_COUNTER_DEEPEST]));
+        result.stackOverflows += counters[SNELL_COUNTER_OVERFLOW];
+        if (countLanes_) {
+            result.lanes.traceSlots += counters[SNELL_COUNTER_TRACE_SLOTS];
+            result.lanes.traceBusy += counters[SNELL_COUNTER_TRACE_BUSY];
+            result.lanes.walkSlots += counters[SNELL_COUNTER_WALK_SLOTS];
+            result.lanes.walkBusy += counters[SNELL_COUNTER_WALK_BUSY];
+        }
+        if (countRays) {
+            result.rays.primary += counters[SNELL_COUNTER_PRIMARY];
+            result.rays.shadow += counters[SNELL_COUNTER_SHADOW];
+            result.rays.reflected += counters[SNELL_COUNTER_REFLECTED];
+            result.rays.refracted += counters[SNELL_COUNTER_REFRACTED];
+        }
+        const std::uint32_t unfinished = counters[SNELL_COUNTER_UNFINISHED];
+        if (request.cancel && request.cancel->load()) throw vk::VulkanError("render cancelled");
+        reportProgress(p, request, plan, tile, progress, unfinished == 0);
+        if (unfinished == 0) break;
+    }
+    progress.whileRunning = nullptr;
+}
+
+// The finished tile, from where the shader wrote it, into `rows` (the image,
+// or the band of rows being streamed, whose first row is `firstRow` of the
+// window), with each pixel's truncation bound.
+void ComputeRenderer::readBackTile(const Pipeline& p, const RenderRequest& request, const TilePlan& plan,
+                                   const gpu::TileParams& tile, Image& rows, int firstRow, Progress& progress,
+                                   GpuRenderResult& result) const {
+    const auto readStart = Clock::now();
+    const PixelWindow& area = plan.area;
+    TruncationReport& truncation = progress.truncation;
+    const auto* pixels = static_cast<const gpu::OutputPixel*>(p.output.mapped);
+    for (std::uint32_t y = 0; y < tile.height; ++y) {
+        const int column = int(tile.originX) - area.x0, windowRow = int(tile.originY + y) - area.y0;
+        float* row = rows.pixel(column, windowRow - firstRow);
+        const gpu::OutputPixel* src = pixels + std::size_t(y) * tile.width;
+        const int imageY = int(tile.originY + y);
+        for (std::uint32_t x = 0; x < tile.width; ++x) {
+            const gpu::OutputPixel& out = src[x];
+            row[x * 3 + 0] = out.colour.r;
+            row[x * 3 + 1] = out.colour.g;
+            row[x * 3 + 2] = out.colour.b;
+            // The pixel's truncation bound, negative where not finite.
+            const float bound = std::abs(out.colour.a);
+            const int imageX = int(tile.originX + x);
+            truncation.addPixel(imageX, imageY, bound, out.colour.a < 0.0f, out.truncation.y != 0.0f);
+            if (out.truncation.x >= 0.0f) truncation.addEstimate(out.truncation.x);
+            if (out.truncation.z != 0.0f) ++truncation.overTolerance;
+            if (request.boundImage)
+                (*request.boundImage)[std::size_t(windowRow) * area.width() + column + x] = bound;
+        }
+    }
+    result.readbackMs += msSince(readStart);
+    ++result.tiles;
+    ++progress.tilesDone;
+}
+
+// Plan the tiles, make sure of the pipeline and its buffers, then each tile:
+// dispatch it and read it back (streaming a band of tiles at a time).
 GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool countRays) {
     GpuRenderResult result;
-    // The window rendered (the whole image unless asked); pixel coordinates
-    // stay those of the whole image, so each pixel is the same either way.
-    const PixelWindow area = request.area();
-    const int areaWidth = area.width(), areaHeight = area.height();
-    if (!request.rowSink) result.image = Image(areaWidth, areaHeight);
-    VkDevice device = context_.device();
     try {
         const auto pipelineStart = Clock::now();
         const Specialisation values = specialise(request, countRays);
-
-        // Tiles: square, at most kMaxTileSide (16 MiB of float image).
-        const int s = std::max(1, request.supersample);
-        const bool wide = layout_.precision == gpu::Precision::Fp64;  // a low part per pending ray too
-        const int tileW = std::min(kMaxTileSide, areaWidth);
-        const int tileH = std::min(kMaxTileSide, areaHeight);
-        // Persistent invocations (trace.comp): on a CPU device a few workgroups
-        // per core keep every core busy to the end of the dispatch; on a GPU
-        // one per pixel, as many as the memory for their ray stacks allows.
-        const VkDeviceSize rayEntries = VkDeviceSize(values[SNELL_SPEC_RAY_STACK]) + values[SNELL_SPEC_FRONTIER];
-        const VkDeviceSize bytesPerSlot =
-            sizeof(gpu::SlotState) +
-            rayEntries * ((wide ? 2 : 1) * sizeof(gpu::PendingRay) + values[SNELL_SPEC_MAX_MEDIA] * 4);
-        const VkDeviceSize limit = context_.properties().limits.maxStorageBufferRange;
-        const VkDeviceSize tilePixels = VkDeviceSize(tileW) * tileH;
-        VkDeviceSize slots = std::min(kStackBudget, limit) / bytesPerSlot;
-        if (context_.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU)
-            slots = std::min<VkDeviceSize>(slots, SNELL_WORKGROUP_SIZE * kCpuWorkgroupsPerCore *
-                                                      std::max(1u, std::thread::hardware_concurrency()));
-        slots = std::clamp<VkDeviceSize>(std::min(slots, tilePixels) / SNELL_WORKGROUP_SIZE, 1, 65535) *
-                SNELL_WORKGROUP_SIZE;
-        result.invocations = static_cast<int>(slots);
-
-        // The pipeline of the last render serves again when the specialisation
-        // is the same, and its buffers when they are large enough (the preview).
-        const bool reuse = cached_ && cached_->values == values;
-        if (!reuse) {
-            if (cached_) destroyPipeline(*cached_);
-            cached_ = std::make_unique<Pipeline>();
-            createPipeline(values, *cached_);
-            cached_->counters = context_.createBuffer(SNELL_COUNTER_COUNT * sizeof(std::uint32_t), kStorage, true);
-        }
-        Pipeline& p = *cached_;
-
-        gpu::FrameParams frameLow{};
-        const gpu::FrameParams frame =
-            gpu::makeFrameParams(scene_, layout_, request.camera, request.width, request.height, s,
-                                 request.firstSample, request.sampleCount, request.trace, &frameLow);
-        context_.destroy(p.frame);
-        context_.destroy(p.frameLow);
-        p.frame = context_.createBufferWithData(&frame, sizeof frame, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
-        if (wide)
-            p.frameLow = context_.createBufferWithData(&frameLow, sizeof frameLow, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
-        if (slots > p.slots) {
-            for (vk::Buffer* b : {&p.slotStates, &p.rayStack, &p.mediaStack, &p.rayStackLow}) context_.destroy(*b);
-            p.slots = slots;
-            // Host-visible: the host reads the invocations' progress while they run.
-            p.slotStates = context_.createBuffer(slots * sizeof(gpu::SlotState), kStorage, true);
-            p.rayStack = context_.createBuffer(slots * p.rayEntries * sizeof(gpu::PendingRay), kStorage, false);
-            p.mediaStack = context_.createBuffer(slots * p.rayEntries * p.maxMedia * 4, kStorage, false);
-            if (wide)
-                p.rayStackLow = context_.createBuffer(slots * p.rayEntries * sizeof(gpu::PendingRay), kStorage, false);
-        }
-        if (tilePixels > p.tilePixels) {
-            context_.destroy(p.output);
-            p.tilePixels = tilePixels;
-            // The tile's pixels, which the host reads where the shader wrote them
-            // (on lavapipe, an imageStore in a loop costs 13x a buffer store).
-            p.output = context_.createBuffer(tilePixels * sizeof(gpu::OutputPixel), kStorage, true);
-        }
-
-        std::array<VkDescriptorBufferInfo, SNELL_BINDING_COUNT> bufferInfo{};
-        std::array<const vk::Buffer*, SNELL_BINDING_COUNT> buffers{};
-        buffers[SNELL_BINDING_OUTPUT] = &p.output;
-        buffers[SNELL_BINDING_FRAME] = &p.frame;
-        buffers[SNELL_BINDING_COUNTERS] = &p.counters;
-        buffers[SNELL_BINDING_SLOT_STATES] = &p.slotStates;
-        buffers[SNELL_BINDING_RAY_STACK] = &p.rayStack;
-        buffers[SNELL_BINDING_MEDIA_STACK] = &p.mediaStack;
-        buffers[SNELL_BINDING_FRAME_LOW] = &p.frameLow;
-        buffers[SNELL_BINDING_RAY_STACK_LOW] = &p.rayStackLow;
-        std::array<VkWriteDescriptorSet, SNELL_BINDING_COUNT> writes{};
-        for (std::uint32_t i = 0; i < p.bindingCount; ++i) {
-            writes[i] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
-            writes[i].dstSet = p.set;
-            writes[i].dstBinding = i;
-            writes[i].descriptorCount = 1;
-            writes[i].descriptorType = descriptorType(i);
-            if (writes[i].descriptorType == VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER) {
-                writes[i].pTexelBufferView = &sceneViews_[i];
-            } else {
-                if (!buffers[i]) buffers[i] = &sceneBuffers_[i];
-                bufferInfo[i] = {buffers[i]->buffer, 0, VK_WHOLE_SIZE};
-                writes[i].pBufferInfo = &bufferInfo[i];
-            }
-        }
-        vkUpdateDescriptorSets(device, p.bindingCount, writes.data(), 0, nullptr);
-
-        // Record, submit and wait for one command buffer.
-        double hostRenderMs = 0.0, gpuRenderMs = 0.0;
-        // While a dispatch runs the host wakes a few times a second for this:
-        // progress read from the invocations' states, and Ctrl-C.
-        std::function<void()> whileRunning;
-        // `setup` is recorded before the timed part, `record`.
-        auto submit = [&](auto setup, auto record, bool timed) {
-            VkCommandBuffer cmd = p.commands;
-            check(vkResetCommandBuffer(cmd, 0), "vkResetCommandBuffer");
-            VkCommandBufferBeginInfo begin{VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO};
-            begin.flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT;
-            check(vkBeginCommandBuffer(cmd, &begin), "vkBeginCommandBuffer");
-            setup(cmd);
-            if (timed && p.queries) {
-                vkCmdResetQueryPool(cmd, p.queries, 0, 2);
-                vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, p.queries, 0);
-            }
-            record(cmd);
-            if (timed && p.queries) vkCmdWriteTimestamp(cmd, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, p.queries, 1);
-            check(vkEndCommandBuffer(cmd), "vkEndCommandBuffer");
-            const auto start = Clock::now();
-            VkSubmitInfo info{VK_STRUCTURE_TYPE_SUBMIT_INFO};
-            info.commandBufferCount = 1;
-            info.pCommandBuffers = &cmd;
-            check(context_.submit(info, p.fence), "vkQueueSubmit");
-            for (;;) {
-                constexpr std::uint64_t kPollNs = 100'000'000;
-                const VkResult waited =
-                    vkWaitForFences(device, 1, &p.fence, VK_TRUE, whileRunning ? kPollNs : UINT64_MAX);
-                if (waited != VK_TIMEOUT) {
-                    check(waited, "vkWaitForFences");
-                    break;
-                }
-                whileRunning();
-            }
-            check(vkResetFences(device, 1, &p.fence), "vkResetFences");
-            if (timed) {
-                hostRenderMs += msSince(start);
-                if (p.queries) {
-                    std::uint64_t stamps[2] = {0, 0};
-                    check(vkGetQueryPoolResults(device, p.queries, 0, 2, sizeof stamps, stamps, sizeof(std::uint64_t),
-                                                VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT),
-                          "vkGetQueryPoolResults");
-                    gpuRenderMs += double(stamps[1] - stamps[0]) * context_.properties().limits.timestampPeriod * 1e-6;
-                }
-            }
-        };
-
-        // An empty dispatch first: llvmpipe compiles a shader at its first
-        // dispatch, and that belongs to pipeline creation, not to the render.
-        if (!reuse) {
-            const gpu::TileParams empty{};
-            std::memset(p.counters.mapped, 0, SNELL_COUNTER_COUNT * sizeof(std::uint32_t));
-            submit([](VkCommandBuffer) {}, [&](VkCommandBuffer cmd) {
-                vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.pipeline);
-                vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.layout, 0, 1, &p.set, 0, nullptr);
-                vkCmdPushConstants(cmd, p.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof empty, &empty);
-                vkCmdDispatch(cmd, 1, 1, 1);
-            }, false);
-        }
+        const TilePlan plan = planTiles(request, values);
+        result.invocations = static_cast<int>(plan.invocations);
+        bool created = false;
+        Pipeline& p = ensurePipeline(values, created);
+        ensureBuffers(p, request, plan);
+        if (created) firstDispatch(p);
         result.pipelineMs = msSince(pipelineStart);
 
-        TruncationReport truncation;
-        if (request.boundImage) request.boundImage->assign(std::size_t(areaWidth) * areaHeight, 0.0f);
+        const PixelWindow& area = plan.area;
+        if (request.boundImage) request.boundImage->assign(std::size_t(area.width()) * area.height(), 0.0f);
+        if (!request.rowSink) result.image = Image(area.width(), area.height());
         // Streaming rows: one band of tile rows at a time.
-        Image band = request.rowSink ? Image(areaWidth, tileH) : Image();
-        const int tilesX = (areaWidth + tileW - 1) / tileW;
-        const int tilesY = (areaHeight + tileH - 1) / tileH;
-        const int tileCount = tilesX * tilesY;
-        auto* counters = static_cast<std::uint32_t*>(p.counters.mapped);
-        // Rays traced in the tiles already finished; the tile in progress adds
-        // its invocations' counts (SlotState::rays).
-        std::uint64_t raysBefore = 0;
-        const auto* states = static_cast<const gpu::SlotState*>(p.slotStates.mapped);
-        auto reportProgress = [&](const gpu::TileParams& tile, bool final) {
-            std::uint64_t finished = 0, rays = raysBefore;
-            for (VkDeviceSize k = 0; k < slots; ++k) {
-                finished += states[k].finished;
-                rays += states[k].rays;
+        Image band = request.rowSink ? Image(area.width(), plan.tileHeight) : Image();
+        Progress progress;
+        for (int ty = 0; ty < plan.tilesY; ++ty) {
+            const int bandRow = ty * plan.tileHeight;
+            for (int tx = 0; tx < plan.tilesX; ++tx) {
+                const gpu::TileParams tile = plan.tile(tx, ty);
+                dispatchTile(p, request, plan, tile, countRays, progress, result);
+                if (request.rowSink) readBackTile(p, request, plan, tile, band, bandRow, progress, result);
+                else readBackTile(p, request, plan, tile, result.image, 0, progress, result);
             }
-            if (request.progress)
-                request.progress((result.tiles + double(finished) / double(tile.width * tile.height)) / tileCount, rays);
-            if (final) raysBefore = rays;
-        };
-        for (int ty = 0; ty < tilesY; ++ty) {
-            for (int tx = 0; tx < tilesX; ++tx) {
-                gpu::TileParams tile{};
-                tile.originX = std::uint32_t(area.x0 + tx * tileW);
-                tile.originY = std::uint32_t(area.y0 + ty * tileH);
-                tile.width = std::uint32_t(std::min(tileW, areaWidth - tx * tileW));
-                tile.height = std::uint32_t(std::min(tileH, areaHeight - ty * tileH));
-                tile.stepX = std::uint32_t(slots % tile.width);
-                tile.stepY = std::uint32_t(slots / tile.width);
-                const std::uint32_t groups = std::uint32_t(slots / SNELL_WORKGROUP_SIZE);
-                // One dispatch renders the tile; where the driver limits loops,
-                // the invocations suspend and the next dispatch resumes them.
-                whileRunning = [&] {
-                    if (request.cancel && request.cancel->load())
-                        std::atomic_ref<std::uint32_t>(counters[SNELL_COUNTER_CANCEL]).store(1u);
-                    reportProgress(tile, false);
-                };
-                for (int pass = 0;; ++pass) {
-                    if (request.cancel && request.cancel->load()) throw vk::VulkanError("render cancelled");
-                    std::memset(counters, 0, SNELL_COUNTER_COUNT * sizeof(std::uint32_t));
-                    tile.resume = pass > 0 ? 1u : 0u;
-                    if (pass == 0) std::memset(p.slotStates.mapped, 0, slots * sizeof(gpu::SlotState));
-                    submit([&](VkCommandBuffer cmd) {
-                        if (pass > 0) {
-                            // The previous dispatch's invocation states and stacks.
-                            memoryBarrier(cmd, VK_ACCESS_SHADER_WRITE_BIT,
-                                          VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT,
-                                          VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
-                        }
-                    }, [&](VkCommandBuffer cmd) {
-                        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.pipeline);
-                        vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.layout, 0, 1, &p.set, 0, nullptr);
-                        vkCmdPushConstants(cmd, p.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof tile, &tile);
-                        vkCmdDispatch(cmd, groups, 1, 1);
-                        memoryBarrier(cmd, VK_ACCESS_SHADER_WRITE_BIT, VK_ACCESS_HOST_READ_BIT,
-                                      VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT);
-                    }, true);
-                    ++result.dispatches;
-                    if (counters[SNELL_COUNTER_LOOP_LIMIT] != 0)
-                        throw vk::VulkanError("a single ray needed more loop iterations than lavapipe allows in one "
-                                              "dispatch (65535 per SIMD row); the image would be wrong. Try fewer "
-                                              "lights or a smaller --depth");
-                    truncation.deepest = std::max(truncation.deepest, int(counters[SNELL_COUNTER_DEEPEST]));
-                    result.stackOverflows += counters[SNELL_COUNTER_OVERFLOW];
-                    if (countLanes_) {
-                        result.lanes.traceSlots += counters[SNELL_COUNTER_TRACE_SLOTS];
-                        result.lanes.traceBusy += counters[SNELL_COUNTER_TRACE_BUSY];
-                        result.lanes.walkSlots += counters[SNELL_COUNTER_WALK_SLOTS];
-                        result.lanes.walkBusy += counters[SNELL_COUNTER_WALK_BUSY];
-                    }
-                    if (countRays) {
-                        result.rays.primary += counters[SNELL_COUNTER_PRIMARY];
-                        result.rays.shadow += counters[SNELL_COUNTER_SHADOW];
-                        result.rays.reflected += counters[SNELL_COUNTER_REFLECTED];
-                        result.rays.refracted += counters[SNELL_COUNTER_REFRACTED];
-                    }
-                    const std::uint32_t unfinished = counters[SNELL_COUNTER_UNFINISHED];
-                    if (request.cancel && request.cancel->load()) throw vk::VulkanError("render cancelled");
-                    if (unfinished == 0) {
-                        reportProgress(tile, true);
-                        break;
-                    }
-                    reportProgress(tile, false);
-                }
-                // The finished tile, from where the shader wrote it.
-                const auto readStart = Clock::now();
-                const auto* pixels = static_cast<const gpu::OutputPixel*>(p.output.mapped);
-                for (std::uint32_t y = 0; y < tile.height; ++y) {
-                    const int column = int(tile.originX) - area.x0, windowRow = int(tile.originY + y) - area.y0;
-                    float* row = request.rowSink ? band.pixel(column, y) : result.image.pixel(column, windowRow);
-                    const gpu::OutputPixel* src = pixels + std::size_t(y) * tile.width;
-                    const int imageY = int(tile.originY + y);
-                    for (std::uint32_t x = 0; x < tile.width; ++x) {
-                        const gpu::OutputPixel& out = src[x];
-                        row[x * 3 + 0] = out.colour.r;
-                        row[x * 3 + 1] = out.colour.g;
-                        row[x * 3 + 2] = out.colour.b;
-                        // The pixel's truncation bound, negative where not finite.
-                        const float bound = std::abs(out.colour.a);
-                        const int imageX = int(tile.originX + x);
-                        truncation.addPixel(imageX, imageY, bound, out.colour.a < 0.0f, out.truncation.y != 0.0f);
-                        if (out.truncation.x >= 0.0f) truncation.addEstimate(out.truncation.x);
-                        if (out.truncation.z != 0.0f) ++truncation.overTolerance;
-                        if (request.boundImage)
-                            (*request.boundImage)[std::size_t(windowRow) * areaWidth + column + x] = bound;
-                    }
-                }
-                result.readbackMs += msSince(readStart);
-                ++result.tiles;
-            }
-            if (request.rowSink) request.rowSink(band.rgb.data(), std::min(tileH, areaHeight - ty * tileH));
+            if (request.rowSink) request.rowSink(band.rgb.data(), std::min(plan.tileHeight, area.height() - bandRow));
         }
-        if (request.truncation) *request.truncation = truncation;
+        if (request.truncation) *request.truncation = progress.truncation;
         result.rayStack = values[SNELL_SPEC_RAY_STACK];
         result.gpuTimed = p.queries != VK_NULL_HANDLE;
-        result.renderMs = result.gpuTimed ? gpuRenderMs : hostRenderMs;
+        result.renderMs = result.gpuTimed ? progress.gpuMs : progress.hostMs;
     } catch (...) {
         // Whatever failed, the kept pipeline's state is unknown: start afresh.
         if (cached_) destroyPipeline(*cached_);

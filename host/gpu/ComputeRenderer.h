@@ -5,6 +5,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <memory>
 
 #include "gpu/GpuScene.h"
@@ -67,11 +68,27 @@ public:
 
 private:
     struct Pipeline;
+    struct TilePlan;
+    struct Progress;
     using Specialisation = std::array<std::uint32_t, SNELL_SPEC_COUNT>;
     Specialisation specialise(const RenderRequest& request, bool countRays) const;
     void createPipeline(const Specialisation& values, Pipeline& pipeline);
     void createComputePipeline(Pipeline& pipeline);
     void destroyPipeline(Pipeline& pipeline);
+    // The phases of render(), in order.
+    TilePlan planTiles(const RenderRequest& request, const Specialisation& values) const;
+    Pipeline& ensurePipeline(const Specialisation& values, bool& created);
+    void ensureBuffers(Pipeline& p, const RenderRequest& request, const TilePlan& plan);
+    void firstDispatch(Pipeline& p);
+    void dispatchTile(Pipeline& p, const RenderRequest& request, const TilePlan& plan, gpu::TileParams tile,
+                      bool countRays, Progress& progress, GpuRenderResult& result);
+    void readBackTile(const Pipeline& p, const RenderRequest& request, const TilePlan& plan,
+                      const gpu::TileParams& tile, Image& rows, int firstRow, Progress& progress,
+                      GpuRenderResult& result) const;
+    void reportProgress(const Pipeline& p, const RenderRequest& request, const TilePlan& plan,
+                        const gpu::TileParams& tile, Progress& progress, bool tileDone) const;
+    void submit(Pipeline& p, Progress& progress, bool timed, bool resumes,
+                const std::function<void(VkCommandBuffer)>& record);
     void destroyBuffers();
     bool spheresInBlock() const;  // every sphere in the uniform block (shared_layout.h)
 

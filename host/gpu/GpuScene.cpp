@@ -61,6 +61,55 @@ double primaryStartDistance(const snell::Scene& scene, const snell::dvec3& eye) 
     return std::max(0.0, nearest - margin);
 }
 
+namespace {
+
+// The BVH over the scene's spheres, laid out for the shader in out.nodes
+// (depth-first, with skip links); returns the spheres in leaf order.
+std::vector<std::uint32_t> layOutBvh(const snell::Scene& scene, const snell::dvec3& eye, GpuScene& out) {
+    const auto start = std::chrono::steady_clock::now();
+    std::vector<snell::Aabb> bounds;
+    bounds.reserve(scene.spheres.size());
+    for (const snell::Sphere& s : scene.spheres) bounds.push_back(snell::sphereBounds(s));
+    const snell::Bvh bvh = snell::buildBvh(bounds, SNELL_BVH_MAX_LEAF);
+    // Depth-first (pre-order) layout with skip links: a node's first child follows it, the
+    // second is its skip link (trace.comp walks it with a short stack).
+    std::vector<std::uint32_t> gpuIndexOf(bvh.nodes.size(), 0);
+    std::vector<std::uint32_t> preorder;
+    preorder.reserve(bvh.nodes.size());
+    std::vector<std::uint32_t> stack{0};
+    while (!stack.empty()) {
+        const std::uint32_t n = stack.back();
+        stack.pop_back();
+        gpuIndexOf[n] = static_cast<std::uint32_t>(preorder.size());
+        preorder.push_back(n);
+        if (bvh.nodes[n].count == 0) {
+            stack.push_back(bvh.nodes[n].first + 1);
+            stack.push_back(bvh.nodes[n].first);
+        }
+    }
+    // Subtree sizes give the skip links: skip = own index + subtree size.
+    std::vector<std::uint32_t> subtree(bvh.nodes.size(), 1);
+    for (auto it = preorder.rbegin(); it != preorder.rend(); ++it) {
+        const snell::BvhNode& n = bvh.nodes[*it];
+        if (n.count == 0) subtree[*it] = 1 + subtree[n.first] + subtree[n.first + 1];
+    }
+    out.nodes.reserve(preorder.size());
+    for (std::uint32_t n : preorder) {
+        const snell::BvhNode& b = bvh.nodes[n];
+        BvhNode node;
+        outwardBox(b.bounds, eye, node.lower, node.upper);
+        // Links as uint bits (shared_layout.h).
+        node.lower.w = std::bit_cast<float>(gpuIndexOf[n] + subtree[n]);
+        node.upper.w = std::bit_cast<float>(b.count > 0 ? b.first * 4 + b.count - 1 : SNELL_BVH_INNER);
+        out.nodes.push_back(node);
+    }
+    out.bvhDepth = bvh.depth;
+    out.bvhBuildMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    return bvh.order;
+}
+
+}  // namespace
+
 GpuScene buildGpuScene(const snell::Scene& scene, const snell::Camera& camera, Precision precision, BvhMode bvh) {
     GpuScene out;
     out.precision = precision;
@@ -79,48 +128,7 @@ GpuScene buildGpuScene(const snell::Scene& scene, const snell::Camera& camera, P
     const bool useBvh = bvh == BvhMode::On ? scene.spheres.size() > 1
                         : bvh == BvhMode::Off ? false
                                               : scene.spheres.size() > kBvhThreshold;
-    if (useBvh) {
-        const auto start = std::chrono::steady_clock::now();
-        std::vector<snell::Aabb> bounds;
-        bounds.reserve(scene.spheres.size());
-        for (const snell::Sphere& s : scene.spheres) bounds.push_back(snell::sphereBounds(s));
-        const snell::Bvh bvh = snell::buildBvh(bounds, SNELL_BVH_MAX_LEAF);
-        // Depth-first (pre-order) layout with skip links: a node's first child follows it, the
-        // second is its skip link (trace.comp walks it with a short stack).
-        std::vector<std::uint32_t> gpuIndexOf(bvh.nodes.size(), 0);
-        std::vector<std::uint32_t> preorder;
-        preorder.reserve(bvh.nodes.size());
-        std::vector<std::uint32_t> stack{0};
-        while (!stack.empty()) {
-            const std::uint32_t n = stack.back();
-            stack.pop_back();
-            gpuIndexOf[n] = static_cast<std::uint32_t>(preorder.size());
-            preorder.push_back(n);
-            if (bvh.nodes[n].count == 0) {
-                stack.push_back(bvh.nodes[n].first + 1);
-                stack.push_back(bvh.nodes[n].first);
-            }
-        }
-        // Subtree sizes give the skip links: skip = own index + subtree size.
-        std::vector<std::uint32_t> subtree(bvh.nodes.size(), 1);
-        for (auto it = preorder.rbegin(); it != preorder.rend(); ++it) {
-            const snell::BvhNode& n = bvh.nodes[*it];
-            if (n.count == 0) subtree[*it] = 1 + subtree[n.first] + subtree[n.first + 1];
-        }
-        out.nodes.reserve(preorder.size());
-        for (std::uint32_t n : preorder) {
-            const snell::BvhNode& b = bvh.nodes[n];
-            BvhNode node;
-            outwardBox(b.bounds, eye, node.lower, node.upper);
-            // Links as uint bits (shared_layout.h).
-            node.lower.w = std::bit_cast<float>(gpuIndexOf[n] + subtree[n]);
-            node.upper.w = std::bit_cast<float>(b.count > 0 ? b.first * 4 + b.count - 1 : SNELL_BVH_INNER);
-            out.nodes.push_back(node);
-        }
-        order = bvh.order;
-        out.bvhDepth = bvh.depth;
-        out.bvhBuildMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-    }
+    if (useBvh) order = layOutBvh(scene, eye, out);
 
     out.spheres.reserve(scene.spheres.size());
     out.sphereMaterials.reserve(scene.spheres.size());
@@ -173,9 +181,11 @@ GpuScene buildGpuScene(const snell::Scene& scene, const snell::Camera& camera, P
     return out;
 }
 
-FrameParams makeFrameParams(const snell::Scene& scene, const GpuScene& gpuScene, const snell::Camera& camera,
-                            int width, int height, int supersample, int firstSample, int sampleCount,
-                            const snell::TraceSettings& trace, FrameParams* lowParts) {
+FrameParams makeFrameParams(const snell::Scene& scene, const GpuScene& gpuScene, const snell::RenderRequest& request,
+                            FrameParams* lowParts) {
+    const snell::Camera& camera = request.camera;
+    const snell::TraceSettings& trace = request.trace;
+    const int supersample = std::max(1, request.supersample);
     FrameParams f{}, low{};
     // A camera other than the one the layout was built for (the preview's)
     // needs its own start distance.
@@ -185,19 +195,23 @@ FrameParams makeFrameParams(const snell::Scene& scene, const GpuScene& gpuScene,
     splitVec4(camera.pixelRight, 0.0, f.pixelRight, low.pixelRight);
     splitVec4(camera.pixelDown, 0.0, f.pixelDown, low.pixelDown);
     if (lowParts) *lowParts = low;
-    f.background = toVec4(scene.background, snell::kAirEta);
-    f.ambient = toVec4(scene.ambient, trace.minWeight);
+    f.background = toVec4(scene.background, 0.0);
+    f.ambient = toVec4(scene.ambient, 0.0);
     // +inf stays +inf in float: the shader tests for it.
     const snell::RadianceBound radiance = snell::radianceBound(scene);
-    f.radiance = toVec4(radiance.radiance, trace.tolerance);
-    f.localRadiance = toVec4(radiance.local, snell::kAmplifiedEstimate);
-    f.imageWidth = static_cast<uint>(width);
-    f.imageHeight = static_cast<uint>(height);
+    f.radiance = toVec4(radiance.radiance, 0.0);
+    f.localRadiance = toVec4(radiance.local, 0.0);
+    f.minWeight = float(trace.minWeight);
+    f.tolerance = float(trace.tolerance);
+    f.amplifiedEstimate = float(snell::kAmplifiedEstimate);
+    f.airEta = float(snell::kAirEta);
+    f.imageWidth = static_cast<uint>(request.width);
+    f.imageHeight = static_cast<uint>(request.height);
     f.supersample = static_cast<uint>(supersample);
     const int grid = supersample * supersample;
-    f.firstSample = static_cast<uint>(std::clamp(firstSample, 0, grid - 1));
-    f.sampleCount = static_cast<uint>(sampleCount > 0 ? std::min(sampleCount, grid - int(f.firstSample))
-                                                      : grid - int(f.firstSample));
+    f.firstSample = static_cast<uint>(std::clamp(request.firstSample, 0, grid - 1));
+    f.sampleCount = static_cast<uint>(request.sampleCount > 0 ? std::min(request.sampleCount, grid - int(f.firstSample))
+                                                              : grid - int(f.firstSample));
     f.maxDepth = static_cast<uint>(trace.maxDepth);
     f.treeBudget = static_cast<uint>(std::min<std::uint64_t>(trace.treeBudget, 0xffffffffu));
     f.estimate = trace.estimate ? 1u : 0u;

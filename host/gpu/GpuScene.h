@@ -22,14 +22,15 @@ static_assert(sizeof(Material) == 48 && offsetof(Material, kt) == 32);
 static_assert(sizeof(Light) == 32 && offsetof(Light, colour) == 16);
 static_assert(sizeof(BvhNode) == 32 && offsetof(BvhNode, upper) == 16);
 static_assert(sizeof(SphereBlock) == 32 * SNELL_BLOCK_SPHERES);
-static_assert(sizeof(FrameParams) == 176 && offsetof(FrameParams, cornerDir) == 16 &&
+static_assert(sizeof(FrameParams) == 192 && offsetof(FrameParams, cornerDir) == 16 &&
               offsetof(FrameParams, radiance) == 96 && offsetof(FrameParams, imageWidth) == 128 &&
-              offsetof(FrameParams, bvhNodeCount) == 152 && offsetof(FrameParams, sampleCount) == 160);
+              offsetof(FrameParams, bvhNodeCount) == 152 && offsetof(FrameParams, sampleCount) == 160 &&
+              offsetof(FrameParams, minWeight) == 172 && offsetof(FrameParams, airEta) == 184);
 static_assert(sizeof(TileParams) == 32 && offsetof(TileParams, resume) == 16 && offsetof(TileParams, stepY) == 24);
-static_assert(sizeof(SlotState) == 160 && offsetof(SlotState, lost) == 32 && offsetof(SlotState, cutOff) == 96 &&
-              offsetof(SlotState, pixel) == 112 && offsetof(SlotState, finished) == 124 &&
-              offsetof(SlotState, treeRays) == 128 && offsetof(SlotState, rays) == 136 &&
-              offsetof(SlotState, frontierOld) == 152);
+static_assert(sizeof(SlotState) == 176 && offsetof(SlotState, lost) == 32 && offsetof(SlotState, pixel) == 96 &&
+              offsetof(SlotState, finished) == 108 && offsetof(SlotState, treeRays) == 112 &&
+              offsetof(SlotState, rays) == 120 && offsetof(SlotState, frontierOld) == 136 &&
+              offsetof(SlotState, cutOff) == 144 && offsetof(SlotState, settledWeight) == 160);
 static_assert(sizeof(OutputPixel) == 32 && offsetof(OutputPixel, truncation) == 16);
 static_assert(sizeof(PendingRay) == 64 && offsetof(PendingRay, depth) == 48 && offsetof(PendingRay, resumeShading) == 60);
 // An ellipsoid's index rides in a float (Sphere::anchorRadius.w), exact to the
@@ -78,11 +79,11 @@ GpuScene buildGpuScene(const snell::Scene& scene, const snell::Camera& camera,
 // How far primary rays from `eye` can go before they could meet any sphere.
 double primaryStartDistance(const snell::Scene& scene, const snell::dvec3& eye);
 
-// The frame parameters of one render (camera relative to camera.eye); with
-// `lowParts`, also the low parts of its float pairs (for the fp64 shader).
-FrameParams makeFrameParams(const snell::Scene& scene, const GpuScene& gpuScene, const snell::Camera& camera,
-                            int width, int height, int supersample, int firstSample, int sampleCount,
-                            const snell::TraceSettings& trace, FrameParams* lowParts = nullptr);
+// The frame parameters of one render request (its camera, size, samples and
+// trace settings); with `lowParts`, also the low parts of its float pairs (for
+// the fp64 shader).
+FrameParams makeFrameParams(const snell::Scene& scene, const GpuScene& gpuScene, const snell::RenderRequest& request,
+                            FrameParams* lowParts = nullptr);
 
 // A double as the float pair hi + lo: hi = float(v), lo = float(v − hi).
 void splitDouble(double v, float& hi, float& lo);

@@ -127,7 +127,13 @@ public:
 
 private:
     void loadScene(std::unique_ptr<Scene> scene);
+    void initGlfw();
+    vk::ContextOptions contextOptions() const;
+    void connectInput();
     void reload();
+    void reloadIfChanged();
+    void reportReload();
+    void printFrameTimes(int framesShown, const std::vector<double>& renderMs, const std::vector<double>& frameMs) const;
     void handleKeys();
     void renderFrame();
     void updateTitle();
@@ -303,6 +309,81 @@ void Session::updateTitle() {
     glfwSetWindowTitle(window_, t.str().c_str());
 }
 
+// GLFW, with a Vulkan loader for windows; WindowError says what is missing.
+void Session::initGlfw() {
+    if (!glfwInit())
+        throw WindowError("cannot open a window (no display? set DISPLAY, or run under Xvfb: xvfb-run snell preview ...)");
+    if (!glfwVulkanSupported()) {
+        glfwTerminate();
+        throw WindowError("GLFW finds no Vulkan loader for windows; install libvulkan1 and mesa-vulkan-drivers");
+    }
+}
+
+// The Vulkan context a window needs: GLFW's instance extensions, a swapchain.
+vk::ContextOptions Session::contextOptions() const {
+    std::uint32_t count = 0;
+    const char** required = glfwGetRequiredInstanceExtensions(&count);
+    vk::ContextOptions options;
+    options.deviceIndex = o_.gpu;
+    options.validation = o_.validation;
+    options.pipelineCachePath = o_.pipelineCachePath;
+    for (std::uint32_t i = 0; i < count; ++i) options.instanceExtensions.push_back(required[i]);
+    options.deviceExtensions.push_back(VK_KHR_SWAPCHAIN_EXTENSION_NAME);
+    return options;
+}
+
+// Mouse and keys move the camera (input_), and the window asks for redraws.
+void Session::connectInput() {
+    input_.camera = &camera_;
+    glfwSetWindowUserPointer(window_, &input_);
+    glfwSetMouseButtonCallback(window_, onMouseButton);
+    glfwSetCursorPosCallback(window_, onCursor);
+    glfwSetScrollCallback(window_, onScroll);
+    glfwSetKeyCallback(window_, onKey);
+    glfwSetWindowRefreshCallback(window_, onRefresh);
+    glfwSetFramebufferSizeCallback(window_, onFramebufferSize);
+}
+
+// Hot reload: the file's modification time, looked at 4 times a second.
+void Session::reloadIfChanged() {
+    if (msBetween(lastPoll_, Clock::now()) < 250.0) return;
+    lastPoll_ = Clock::now();
+    const fs::file_time_type t = modificationTime(o_.scene);
+    if (t == sceneTime_) return;
+    sceneTime_ = t;
+    savedAt_ = std::chrono::file_clock::to_sys(t);
+    reload();
+}
+
+// The first frame after a reload is shown: how long it took.
+void Session::reportReload() {
+    const double ms = msBetween(*reloadStart_, Clock::now());
+    if (!o_.quiet) {
+        std::cerr << "snell: reloaded " << o_.scene << ": new image " << ms << " ms after the change was seen";
+        if (savedAt_)
+            std::cerr << ", "
+                      << std::chrono::duration<double, std::milli>(std::chrono::system_clock::now() - *savedAt_).count()
+                      << " ms after the save";
+        std::cerr << "\n";
+    }
+    reloadStart_.reset();
+}
+
+// A scripted run's frame times (rendered frames only), medians.
+void Session::printFrameTimes(int framesShown, const std::vector<double>& renderMs,
+                              const std::vector<double>& frameMs) const {
+    auto median = [](std::vector<double> v) {
+        std::sort(v.begin(), v.end());
+        return v[v.size() / 2];
+    };
+    std::cerr << "snell: " << framesShown << " frames shown, " << frameMs.size() << " rendered ("
+              << (o_.orbitPerFrame != 0.0
+                      ? "moving, " + std::to_string(frameSide_) + "x" + std::to_string(frameSide_) + " of "
+                      : std::string())
+              << size_ << "x" << size_ << "): median " << median(renderMs) << " ms rendering, " << median(frameMs)
+              << " ms a frame in all (" << 1000.0 / median(frameMs) << " frames a second)\n";
+}
+
 void Session::run() {
     auto first = std::make_unique<Scene>(parseSceneFile(o_.scene));  // ParseError: the caller's
     if (!o_.quiet)
@@ -312,12 +393,7 @@ void Session::run() {
     if (o_.depth) trace_.maxDepth = *o_.depth;
     if (o_.minWeight) trace_.minWeight = *o_.minWeight;
 
-    if (!glfwInit())
-        throw WindowError("cannot open a window (no display? set DISPLAY, or run under Xvfb: xvfb-run snell preview ...)");
-    if (!glfwVulkanSupported()) {
-        glfwTerminate();
-        throw WindowError("GLFW finds no Vulkan loader for windows; install libvulkan1 and mesa-vulkan-drivers");
-    }
+    initGlfw();
     struct Terminate {
         GLFWwindow*& window;
         ~Terminate() {
@@ -332,15 +408,7 @@ void Session::run() {
     window_ = glfwCreateWindow(windowSide, windowSide, "snell preview", nullptr, nullptr);
     if (!window_) throw WindowError("GLFW could not create a window");
 
-    std::uint32_t count = 0;
-    const char** required = glfwGetRequiredInstanceExtensions(&count);
-    vk::ContextOptions options;
-    options.deviceIndex = o_.gpu;
-    options.validation = o_.validation;
-    options.pipelineCachePath = o_.pipelineCachePath;
-    for (std::uint32_t i = 0; i < count; ++i) options.instanceExtensions.push_back(required[i]);
-    options.deviceExtensions.push_back(VK_KHR_SWAPCHAIN_EXTENSION_NAME);
-    context_ = std::make_unique<vk::Context>(options);
+    context_ = std::make_unique<vk::Context>(contextOptions());
     struct Release {  // Vulkan objects go before the window and GLFW
         Session& s;
         ~Release() {
@@ -353,14 +421,7 @@ void Session::run() {
     loadScene(std::move(first));
     if (o_.orbitDegrees != 0.0) camera_.orbitDegrees(o_.orbitDegrees);
 
-    input_.camera = &camera_;
-    glfwSetWindowUserPointer(window_, &input_);
-    glfwSetMouseButtonCallback(window_, onMouseButton);
-    glfwSetCursorPosCallback(window_, onCursor);
-    glfwSetScrollCallback(window_, onScroll);
-    glfwSetKeyCallback(window_, onKey);
-    glfwSetWindowRefreshCallback(window_, onRefresh);
-    glfwSetFramebufferSizeCallback(window_, onFramebufferSize);
+    connectInput();
     updateTitle();
 
     int framesShown = 0;
@@ -382,16 +443,7 @@ void Session::run() {
         }
         handleKeys();
 
-        // Hot reload: the file's modification time, looked at 4 times a second.
-        if (msBetween(lastPoll_, Clock::now()) >= 250.0) {
-            lastPoll_ = Clock::now();
-            const fs::file_time_type t = modificationTime(o_.scene);
-            if (t != sceneTime_) {
-                sceneTime_ = t;
-                savedAt_ = std::chrono::file_clock::to_sys(t);
-                reload();
-            }
-        }
+        reloadIfChanged();
 
         int fbWidth = 0, fbHeight = 0;
         glfwGetFramebufferSize(window_, &fbWidth, &fbHeight);
@@ -417,36 +469,13 @@ void Session::run() {
         }
         lastShown = Clock::now();
         updateTitle();
-        if (reloadStart_) {
-            const double ms = msBetween(*reloadStart_, Clock::now());
-            if (!o_.quiet) {
-                std::cerr << "snell: reloaded " << o_.scene << ": new image " << ms << " ms after the change was seen";
-                if (savedAt_)
-                    std::cerr << ", "
-                              << std::chrono::duration<double, std::milli>(std::chrono::system_clock::now() - *savedAt_)
-                                     .count()
-                              << " ms after the save";
-                std::cerr << "\n";
-            }
-            reloadStart_.reset();
-        }
+        if (reloadStart_) reportReload();
         if (o_.frames > 0 && framesShown >= o_.frames) {
             if (!o_.screenshot.empty()) saveScreenshot(o_.screenshot);
             break;
         }
     }
-    if (o_.frames > 0 && !o_.quiet && !frameMs.empty()) {  // rendered frames only
-        auto median = [](std::vector<double> v) {
-            std::sort(v.begin(), v.end());
-            return v[v.size() / 2];
-        };
-        std::cerr << "snell: " << framesShown << " frames shown, " << frameMs.size() << " rendered ("
-                  << (o_.orbitPerFrame != 0.0 ? "moving, " + std::to_string(frameSide_) + "x" +
-                                                    std::to_string(frameSide_) + " of "
-                                              : std::string())
-                  << size_ << "x" << size_ << "): median " << median(renderMs) << " ms rendering, "
-                  << median(frameMs) << " ms a frame in all (" << 1000.0 / median(frameMs) << " frames a second)\n";
-    }
+    if (o_.frames > 0 && !o_.quiet && !frameMs.empty()) printFrameTimes(framesShown, renderMs, frameMs);
     if (o_.validation && context_->validationMessages() > 0)
         throw vk::VulkanError("the Vulkan validation layer reported " +
                               std::to_string(context_->validationMessages()) + " message(s)");

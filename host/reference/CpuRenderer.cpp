@@ -59,6 +59,22 @@ void addWeighted(dvec3& sum, const dvec3& weight, const dvec3& colour) { sum += 
 constexpr double kMaxWeight = 1e30;
 dvec3 childWeight(const dvec3& weight, const dvec3& gain) { return glm::min(weighted(weight, gain), dvec3(kMaxWeight)); }
 
+// A ray refracted at a surface of `sphere` (material m), entering it or
+// leaving: the refractive index of the medium it leaves over that of the one
+// it enters (SPEC §4.5), and `media` becomes the refracted ray's medium stack.
+double crossSurface(const Scene& scene, bool entering, const Material& m, std::uint32_t sphere, MediumStack& media) {
+    auto innermostEta = [&] {
+        return media.size > 0 ? scene.materials[scene.spheres[media.spheres[media.size - 1]].material].eta : kAirEta;
+    };
+    if (entering) {
+        const double etaI = innermostEta();
+        media.push(sphere);
+        return etaI / m.eta;
+    }
+    media.remove(sphere);
+    return m.eta / innermostEta();
+}
+
 bool rayHitsBox(const Aabb& box, const dvec3& origin, const dvec3& inverseDir, double tMax) {
     // Slab test; inverseDir components may be ±inf, which the min/max handle.
     double t0 = 0.0, t1 = tMax;
@@ -105,6 +121,21 @@ struct CpuRenderer::TreeTrace {
     int deepest = 0;
     bool overBudget = false;
     bool amplified = false;       // a hit gained weight (ks + kt > 1 where the ray carried light)
+
+    // A ray under the cut-off: the next, lower cut-off starts from it (under
+    // the floor no cut-off will, and it is lost; but in an amplifying scene a
+    // pixel may go below the floor, renderPixel).
+    void defer(PendingRay&& r, const TraceSettings& settings, bool amplifying) {
+        const double m = maxComponent(r.weight);
+        if (!(m > 0.0)) return;
+        if (!(settings.tolerance > 0.0) || (m < settings.minWeight && !amplifying)) {
+            lost += r.weight;
+            return;
+        }
+        deferred += r.weight;
+        heaviestDeferred = std::max(heaviestDeferred, m);
+        frontier.push_back(std::move(r));
+    }
 };
 
 CpuRenderer::CpuRenderer(const Scene& scene) : scene_(scene) {
@@ -194,28 +225,112 @@ bool CpuRenderer::occluded(const Ray& ray, double distance, std::uint32_t fromSp
 // weight is dropped from then on. A ray under the cut-off waits in
 // tree.frontier for a lower one; one that the depth limit or the budget stops
 // is lost (render/Truncation.h).
+// The outward normal No of `sphere` at the point o + t d of `ray` (an
+// ellipsoid's through its object frame: the transposed inverse map).
+dvec3 CpuRenderer::outwardNormal(const Sphere& sphere, const Ray& ray, double t) const {
+    if (sphere.isTrueSphere) return glm::normalize(ray.origin - sphere.centre + t * ray.direction);
+    const dvec3 o = dvec3(sphere.objectFromWorld * glm::dvec4(ray.origin, 1.0));
+    const dvec3 p = o + t * (glm::dmat3(sphere.objectFromWorld) * ray.direction);
+    return glm::normalize(glm::transpose(glm::dmat3(sphere.objectFromWorld)) * p);
+}
+
+// The local Phong term at x on sphere `hitSphere`, with shading normal n,
+// seen from v: ambient, then each light in order, with binary shadows
+// (SPEC §4.3).
+dvec3 CpuRenderer::localTerm(const Material& m, std::uint32_t hitSphere, const dvec3& x, const dvec3& n,
+                              const dvec3& v, bool fromOutside, const TraceSettings& settings,
+                              RayCounts& counts) const {
+    dvec3 local = scene_.ambient * m.kd;
+    for (const Light& light : scene_.lights) {
+        dvec3 l = light.position - x;
+        const double distance = glm::length(l);
+        l /= distance;
+        const double nl = glm::dot(n, l);
+        if (!(nl > 0.0)) continue;
+        if (settings.shadows) ++counts.shadow;
+        // A shadow ray towards N's side enters the sphere only when N = −No.
+        if (settings.shadows &&
+            occluded({x, l}, distance, hitSphere, fromOutside ? StartsOn::Leaving : StartsOn::Entering))
+            continue;
+        const dvec3 reflectedLight = 2.0 * nl * n - l;
+        const double rv = glm::dot(reflectedLight, v);
+        const double specular = rv > 0.0 ? std::pow(rv, m.phong) : 0.0;
+        local += light.colour * (m.kd * nl + m.ks * specular);
+    }
+    return local;
+}
+
+// 4–5. The children of ray r at its hit on sphere `hitSphere` (material m,
+// point x, shading normal n): reflection (keeping the medium stack) and
+// refraction (SPEC §4.5), each traced (on `stack`) or, under the cut-off,
+// deferred to a lower one; weight the depth limit stops is lost
+// (render/Truncation.h). trace.comp's spawnChildren is its twin.
+void CpuRenderer::spawnChildren(const PendingRay& r, const Material& m, std::uint32_t hitSphere, const dvec3& x,
+                                const dvec3& n, bool fromOutside, double cutOff, const TraceSettings& settings,
+                                TreeTrace& tree, std::vector<PendingRay>& stack) const {
+    const dvec3 d = r.ray.direction;
+    auto worthTracing = [&](const dvec3& w) {
+        const double mw = maxComponent(w);
+        return mw > 0.0 && mw >= cutOff;
+    };
+    auto defer = [&](PendingRay&& child) { tree.defer(std::move(child), settings, amplifying_); };
+    const dvec3 reflectedGain = settings.reflection ? m.ks : dvec3(0.0);
+    const dvec3 transmittedGain = settings.refraction && m.refracts() ? m.kt : dvec3(0.0);
+    if (r.depth >= settings.maxDepth) {
+        tree.lost += weighted(r.weight, reflectedGain + transmittedGain);
+        return;
+    }
+
+    // Light carried into a material of ks + kt > 1 (SPEC §4 amplifying
+    // materials) can grow: an orbit of total internal reflection repeats
+    // its angle for ever, and a path of tiny weight that enters one grows
+    // until its channel saturates. The pixel's series may diverge behind
+    // steps that seem to settle, so its estimated error must be within
+    // kAmplifiedEstimate.
+    for (int c = 0; c < 3; ++c)
+        if (reflectedGain[c] + transmittedGain[c] > 1.0 && r.weight[c] > 0.0) tree.amplified = true;
+    dvec3 reflectedWeight = childWeight(r.weight, reflectedGain);
+    std::optional<PendingRay> refractedRay;
+    if (settings.refraction && m.refracts()) {
+        const dvec3 transmittedWeight = childWeight(r.weight, transmittedGain);
+        MediumStack media = r.media;
+        const double eta = crossSurface(scene_, fromOutside, m, hitSphere, media);
+        dvec3 refracted;
+        if (!refractDirection(d, n, eta, refracted)) {
+            // Total internal reflection is the reflected ray in the same
+            // medium: one ray carrying both weights (exactly SPEC §4.5).
+            reflectedWeight = glm::min(reflectedWeight + transmittedWeight, dvec3(kMaxWeight));
+        } else {
+            PendingRay child{{x, refracted}, transmittedWeight, r.depth + 1, hitSphere, fromOutside, true, media};
+            if (worthTracing(transmittedWeight)) refractedRay = std::move(child);
+            else defer(std::move(child));
+        }
+    }
+    std::optional<PendingRay> reflectedRay;
+    PendingRay reflectedChild{{x, reflectDirection(d, n)}, reflectedWeight, r.depth + 1, hitSphere, !fromOutside,
+                              false, r.media};
+    if (worthTracing(reflectedWeight)) reflectedRay = std::move(reflectedChild);
+    else defer(std::move(reflectedChild));
+    // The lighter child is traced next and the heavier waits (as the
+    // shader does, whose stack this bounds: ComputeRenderer.cpp); in an
+    // amplifying scene the heavier goes first, so that a tree budget is
+    // spent on the weightiest rays, those that saturate a diverging channel.
+    if (reflectedRay && refractedRay &&
+        (maxComponent(reflectedRay->weight) < maxComponent(refractedRay->weight)) != amplifying_)
+        std::swap(reflectedRay, refractedRay);
+    if (reflectedRay) stack.push_back(std::move(*reflectedRay));
+    if (refractedRay) stack.push_back(std::move(*refractedRay));
+}
+
 void CpuRenderer::trace(const PendingRay& root, dvec3& pixelSum, double saturation, double cutOff,
                         const TraceSettings& settings, RayCounts& counts, TreeTrace& tree) const {
     std::vector<PendingRay> stack;
     stack.push_back(root);
-    const bool continues = settings.tolerance > 0.0;
     auto worthTracing = [&](const dvec3& w) {
         const double m = maxComponent(w);
         return m > 0.0 && m >= cutOff;
     };
-    // A ray under the cut-off: the next, lower cut-off starts from it (under
-    // the floor no cut-off will, and it is lost).
-    auto defer = [&](PendingRay&& r) {
-        const double m = maxComponent(r.weight);
-        if (!(m > 0.0)) return;
-        if (!continues || (m < settings.minWeight && !amplifying_)) {
-            tree.lost += r.weight;
-            return;
-        }
-        tree.deferred += r.weight;
-        tree.heaviestDeferred = std::max(tree.heaviestDeferred, m);
-        tree.frontier.push_back(std::move(r));
-    };
+    auto defer = [&](PendingRay&& r) { tree.defer(std::move(r), settings, amplifying_); };
     while (!stack.empty()) {
         PendingRay r = std::move(stack.back());
         stack.pop_back();
@@ -247,95 +362,17 @@ void CpuRenderer::trace(const PendingRay& root, dvec3& pixelSum, double saturati
         // 2. Hit point, outward normal No, shading normal N.
         // The hit point is o + t d, not re-projected (see trace.comp).
         const dvec3 x = r.ray.origin + hit.t * r.ray.direction;
-        dvec3 outward;
-        if (sphere.isTrueSphere) {
-            outward = glm::normalize(r.ray.origin - sphere.centre + hit.t * r.ray.direction);
-        } else {
-            const dvec3 o = dvec3(sphere.objectFromWorld * glm::dvec4(r.ray.origin, 1.0));
-            const dvec3 p = o + hit.t * (glm::dmat3(sphere.objectFromWorld) * r.ray.direction);
-            outward = glm::normalize(glm::transpose(glm::dmat3(sphere.objectFromWorld)) * p);
-        }
+        const dvec3 outward = outwardNormal(sphere, r.ray, hit.t);
         const dvec3 d = r.ray.direction;
         const bool fromOutside = glm::dot(d, outward) < 0.0;
         const dvec3 n = fromOutside ? outward : -outward;
         const dvec3 v = -d;
 
         // 3. Local Phong term with binary shadows.
-        dvec3 local = scene_.ambient * m.kd;
-        for (const Light& light : scene_.lights) {
-            dvec3 l = light.position - x;
-            const double distance = glm::length(l);
-            l /= distance;
-            const double nl = glm::dot(n, l);
-            if (!(nl > 0.0)) continue;
-            if (settings.shadows) ++counts.shadow;
-            // A shadow ray towards N's side enters the sphere only when N = −No.
-            if (settings.shadows &&
-                occluded({x, l}, distance, hit.sphere, fromOutside ? StartsOn::Leaving : StartsOn::Entering))
-                continue;
-            const dvec3 reflectedLight = 2.0 * nl * n - l;
-            const double rv = glm::dot(reflectedLight, v);
-            const double specular = rv > 0.0 ? std::pow(rv, m.phong) : 0.0;
-            local += light.colour * (m.kd * nl + m.ks * specular);
-        }
-        addWeighted(pixelSum, r.weight, local);
+        addWeighted(pixelSum, r.weight, localTerm(m, hit.sphere, x, n, v, fromOutside, settings, counts));
 
         // 4–5. Children: reflection, and refraction through the medium stack.
-        const dvec3 reflectedGain = settings.reflection ? m.ks : dvec3(0.0);
-        const dvec3 transmittedGain = settings.refraction && m.refracts() ? m.kt : dvec3(0.0);
-        if (r.depth >= settings.maxDepth) {
-            tree.lost += weighted(r.weight, reflectedGain + transmittedGain);
-            continue;
-        }
-
-        // Light carried into a material of ks + kt > 1 (SPEC §4 amplifying
-        // materials) can grow: an orbit of total internal reflection repeats
-        // its angle for ever, and a path of tiny weight that enters one grows
-        // until its channel saturates. The pixel's series may diverge behind
-        // steps that seem to settle, so its estimated error must be within
-        // kAmplifiedEstimate.
-        for (int c = 0; c < 3; ++c)
-            if (reflectedGain[c] + transmittedGain[c] > 1.0 && r.weight[c] > 0.0) tree.amplified = true;
-        dvec3 reflectedWeight = childWeight(r.weight, reflectedGain);
-        std::optional<PendingRay> refractedRay;
-        if (settings.refraction && m.refracts()) {
-            const dvec3 transmittedWeight = childWeight(r.weight, transmittedGain);
-            MediumStack media = r.media;
-            double etaI, etaT;
-            if (fromOutside) {
-                etaI = media.size > 0 ? scene_.materials[scene_.spheres[media.spheres[media.size - 1]].material].eta : kAirEta;
-                etaT = m.eta;
-                media.push(hit.sphere);
-            } else {
-                etaI = m.eta;
-                media.remove(hit.sphere);
-                etaT = media.size > 0 ? scene_.materials[scene_.spheres[media.spheres[media.size - 1]].material].eta : kAirEta;
-            }
-            dvec3 refracted;
-            if (!refractDirection(d, n, etaI / etaT, refracted)) {
-                // Total internal reflection is the reflected ray in the same
-                // medium: one ray carrying both weights (exactly SPEC §4.5).
-                reflectedWeight = glm::min(reflectedWeight + transmittedWeight, dvec3(kMaxWeight));
-            } else {
-                PendingRay child{{x, refracted}, transmittedWeight, r.depth + 1, hit.sphere, fromOutside, true, media};
-                if (worthTracing(transmittedWeight)) refractedRay = std::move(child);
-                else defer(std::move(child));
-            }
-        }
-        std::optional<PendingRay> reflectedRay;
-        PendingRay reflectedChild{{x, reflectDirection(d, n)}, reflectedWeight, r.depth + 1, hit.sphere, !fromOutside,
-                                  false, r.media};
-        if (worthTracing(reflectedWeight)) reflectedRay = std::move(reflectedChild);
-        else defer(std::move(reflectedChild));
-        // The lighter child is traced next and the heavier waits (as the
-        // shader does, whose stack this bounds: ComputeRenderer.cpp); in an
-        // amplifying scene the heavier goes first, so that a tree budget is
-        // spent on the weightiest rays, those that saturate a diverging channel.
-        if (reflectedRay && refractedRay &&
-            (maxComponent(reflectedRay->weight) < maxComponent(refractedRay->weight)) != amplifying_)
-            std::swap(reflectedRay, refractedRay);
-        if (reflectedRay) stack.push_back(std::move(*reflectedRay));
-        if (refractedRay) stack.push_back(std::move(*refractedRay));
+        spawnChildren(r, m, hit.sphere, x, n, fromOutside, cutOff, settings, tree, stack);
     }
 }
 

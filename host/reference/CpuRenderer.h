@@ -38,6 +38,13 @@ private:
     struct TreeTrace;
     void trace(const PendingRay& root, glm::dvec3& pixelSum, double saturation, double cutOff,
                const TraceSettings& settings, RayCounts& counts, TreeTrace& tree) const;
+    void spawnChildren(const PendingRay& r, const Material& m, std::uint32_t hitSphere, const glm::dvec3& x,
+                       const glm::dvec3& n, bool fromOutside, double cutOff, const TraceSettings& settings,
+                       TreeTrace& tree, std::vector<PendingRay>& stack) const;
+    glm::dvec3 outwardNormal(const Sphere& sphere, const Ray& ray, double t) const;
+    glm::dvec3 localTerm(const Material& m, std::uint32_t hitSphere, const glm::dvec3& x, const glm::dvec3& n,
+                         const glm::dvec3& v, bool fromOutside, const TraceSettings& settings,
+                         RayCounts& counts) const;
     bool closestHit(const Ray& ray, std::uint32_t fromSphere, StartsOn start, Hit& hit) const;
     bool occluded(const Ray& ray, double distance, std::uint32_t fromSphere, StartsOn start) const;
     double intersect(std::uint32_t sphere, const Ray& ray, std::uint32_t fromSphere, StartsOn start) const;

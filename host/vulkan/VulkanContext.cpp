@@ -264,42 +264,10 @@ Context::Context(const ContextOptions& options) : fault_(options.fault) {
             if (create) check(create(instance_, &info, nullptr, &messenger_), "vkCreateDebugUtilsMessengerEXT");
         }
         const std::vector<VkPhysicalDevice> devices = enumerate(instance_);
-        if (devices.empty()) throw NoDeviceError(std::string("no Vulkan device found: ") + kInstallHint);
-        int best = -1, bestRank = -1;
-        std::vector<std::uint32_t> families(devices.size());
-        for (std::size_t i = 0; i < devices.size(); ++i) {
-            reports_.push_back(examine(devices[i], static_cast<int>(i), families[i], options.deviceExtensions));
-            VkPhysicalDeviceProperties props;
-            vkGetPhysicalDeviceProperties(devices[i], &props);
-            if (options.deviceIndex >= 0) {
-                if (static_cast<int>(i) != options.deviceIndex && reports_.back().usable)
-                    reports_.back().reason = "not the device asked for (--gpu " + std::to_string(options.deviceIndex) + ")";
-                continue;
-            }
-            if (reports_.back().usable && typeRank(props.deviceType) > bestRank) {
-                best = static_cast<int>(i);
-                bestRank = typeRank(props.deviceType);
-            }
-        }
-        if (options.deviceIndex >= 0) {
-            if (options.deviceIndex >= static_cast<int>(devices.size()))
-                throw NoDeviceError("--gpu " + std::to_string(options.deviceIndex) + ": there are only " +
-                                    std::to_string(devices.size()) + " Vulkan device(s); see 'snell devices'");
-            if (!reports_[options.deviceIndex].usable)
-                throw NoDeviceError("device " + std::to_string(options.deviceIndex) + " (" +
-                                    reports_[options.deviceIndex].name + ") cannot be used: " +
-                                    reports_[options.deviceIndex].reason);
-            best = options.deviceIndex;
-        }
-        if (best < 0) {
-            std::string why = "no usable Vulkan device:";
-            for (const DeviceReport& r : reports_) why += "\n  device " + std::to_string(r.index) + " " + r.name + ": " + r.reason;
-            throw NoDeviceError(why + "\n" + kInstallHint);
-        }
-        for (DeviceReport& r : reports_)
-            if (r.index != best && r.usable && r.reason.empty()) r.reason = "a device of a preferred type was chosen";
+        std::uint32_t family = 0;
+        const int best = chooseDevice(devices, options, family);
         physical_ = devices[best];
-        queueFamily_ = families[best];
+        queueFamily_ = family;
         deviceName_ = reports_[best].name;
         driverInfo_ = reports_[best].driver;
         vkGetPhysicalDeviceProperties(physical_, &properties_);
@@ -314,52 +282,104 @@ Context::Context(const ContextOptions& options) : fault_(options.fault) {
         vkGetPhysicalDeviceQueueFamilyProperties(physical_, &count, qf.data());
         timestampValidBits_ = qf[queueFamily_].timestampValidBits;
 
-        VkPhysicalDeviceFeatures supported;
-        vkGetPhysicalDeviceFeatures(physical_, &supported);
-        VkPhysicalDeviceFeatures enabled{};
-        float64_ = supported.shaderFloat64;
-        enabled.shaderFloat64 = supported.shaderFloat64;
-        const float priority = 1.0f;
-        VkDeviceQueueCreateInfo queueInfo{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
-        queueInfo.queueFamilyIndex = queueFamily_;
-        queueInfo.queueCount = 1;
-        queueInfo.pQueuePriorities = &priority;
-        std::vector<const char*> exts;
-        for (const std::string& e : options.deviceExtensions) exts.push_back(e.c_str());
-        VkDeviceCreateInfo info{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
-        info.queueCreateInfoCount = 1;
-        info.pQueueCreateInfos = &queueInfo;
-        info.pEnabledFeatures = &enabled;
-        info.enabledExtensionCount = static_cast<std::uint32_t>(exts.size());
-        info.ppEnabledExtensionNames = exts.data();
-        check(vkCreateDevice(physical_, &info, nullptr, &device_), "vkCreateDevice");
-        vkGetDeviceQueue(device_, queueFamily_, 0, &queue_);
-        VkCommandPoolCreateInfo poolInfo{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
-        poolInfo.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
-        poolInfo.queueFamilyIndex = queueFamily_;
-        check(vkCreateCommandPool(device_, &poolInfo, nullptr, &pool_), "vkCreateCommandPool");
-        VkFenceCreateInfo fenceInfo{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
-        check(vkCreateFence(device_, &fenceInfo, nullptr, &fence_), "vkCreateFence");
-
-        // The pipeline cache: what earlier runs compiled, when the file holds
-        // data for this device and driver (the driver checks and ignores any other).
-        pipelineCachePath_ = options.pipelineCachePath;
-        std::vector<char> initial;
-        if (!pipelineCachePath_.empty()) {
-            std::ifstream in(pipelineCachePath_, std::ios::binary);
-            initial.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-        }
-        VkPipelineCacheCreateInfo cacheInfo{VK_STRUCTURE_TYPE_PIPELINE_CACHE_CREATE_INFO};
-        cacheInfo.initialDataSize = initial.size();
-        cacheInfo.pInitialData = initial.empty() ? nullptr : initial.data();
-        if (vkCreatePipelineCache(device_, &cacheInfo, nullptr, &pipelineCache_) != VK_SUCCESS) {
-            cacheInfo.initialDataSize = 0;  // unreadable data: start empty
-            cacheInfo.pInitialData = nullptr;
-            check(vkCreatePipelineCache(device_, &cacheInfo, nullptr, &pipelineCache_), "vkCreatePipelineCache");
-        }
+        createDevice(options.deviceExtensions);
+        openPipelineCache(options.pipelineCachePath);
     } catch (...) {
         release();
         throw;
+    }
+}
+
+// Examines every device (reports_: why each was passed over) and picks the
+// one asked for (--gpu), else the usable one of the most preferred type;
+// `family` is its compute queue family.
+int Context::chooseDevice(const std::vector<VkPhysicalDevice>& devices, const ContextOptions& options,
+                          std::uint32_t& family) {
+    if (devices.empty()) throw NoDeviceError(std::string("no Vulkan device found: ") + kInstallHint);
+    int best = -1, bestRank = -1;
+    std::vector<std::uint32_t> families(devices.size());
+    for (std::size_t i = 0; i < devices.size(); ++i) {
+        reports_.push_back(examine(devices[i], static_cast<int>(i), families[i], options.deviceExtensions));
+        VkPhysicalDeviceProperties props;
+        vkGetPhysicalDeviceProperties(devices[i], &props);
+        if (options.deviceIndex >= 0) {
+            if (static_cast<int>(i) != options.deviceIndex && reports_.back().usable)
+                reports_.back().reason = "not the device asked for (--gpu " + std::to_string(options.deviceIndex) + ")";
+            continue;
+        }
+        if (reports_.back().usable && typeRank(props.deviceType) > bestRank) {
+            best = static_cast<int>(i);
+            bestRank = typeRank(props.deviceType);
+        }
+    }
+    if (options.deviceIndex >= 0) {
+        if (options.deviceIndex >= static_cast<int>(devices.size()))
+            throw NoDeviceError("--gpu " + std::to_string(options.deviceIndex) + ": there are only " +
+                                std::to_string(devices.size()) + " Vulkan device(s); see 'snell devices'");
+        if (!reports_[options.deviceIndex].usable)
+            throw NoDeviceError("device " + std::to_string(options.deviceIndex) + " (" +
+                                reports_[options.deviceIndex].name + ") cannot be used: " +
+                                reports_[options.deviceIndex].reason);
+        best = options.deviceIndex;
+    }
+    if (best < 0) {
+        std::string why = "no usable Vulkan device:";
+        for (const DeviceReport& r : reports_) why += "\n  device " + std::to_string(r.index) + " " + r.name + ": " + r.reason;
+        throw NoDeviceError(why + "\n" + kInstallHint);
+    }
+    for (DeviceReport& r : reports_)
+        if (r.index != best && r.usable && r.reason.empty()) r.reason = "a device of a preferred type was chosen";
+    family = families[best];
+    return best;
+}
+
+// The logical device with one compute queue, shader doubles where the device
+// has them, and the one-off command pool and fence.
+void Context::createDevice(const std::vector<std::string>& extensions) {
+    VkPhysicalDeviceFeatures supported;
+    vkGetPhysicalDeviceFeatures(physical_, &supported);
+    VkPhysicalDeviceFeatures enabled{};
+    float64_ = supported.shaderFloat64;
+    enabled.shaderFloat64 = supported.shaderFloat64;
+    const float priority = 1.0f;
+    VkDeviceQueueCreateInfo queueInfo{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
+    queueInfo.queueFamilyIndex = queueFamily_;
+    queueInfo.queueCount = 1;
+    queueInfo.pQueuePriorities = &priority;
+    std::vector<const char*> exts;
+    for (const std::string& e : extensions) exts.push_back(e.c_str());
+    VkDeviceCreateInfo info{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
+    info.queueCreateInfoCount = 1;
+    info.pQueueCreateInfos = &queueInfo;
+    info.pEnabledFeatures = &enabled;
+    info.enabledExtensionCount = static_cast<std::uint32_t>(exts.size());
+    info.ppEnabledExtensionNames = exts.data();
+    check(vkCreateDevice(physical_, &info, nullptr, &device_), "vkCreateDevice");
+    vkGetDeviceQueue(device_, queueFamily_, 0, &queue_);
+    VkCommandPoolCreateInfo poolInfo{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
+    poolInfo.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
+    poolInfo.queueFamilyIndex = queueFamily_;
+    check(vkCreateCommandPool(device_, &poolInfo, nullptr, &pool_), "vkCreateCommandPool");
+    VkFenceCreateInfo fenceInfo{VK_STRUCTURE_TYPE_FENCE_CREATE_INFO};
+    check(vkCreateFence(device_, &fenceInfo, nullptr, &fence_), "vkCreateFence");
+}
+
+// The pipeline cache: what earlier runs compiled, when the file holds data
+// for this device and driver (the driver checks and ignores any other).
+void Context::openPipelineCache(const std::string& path) {
+    pipelineCachePath_ = path;
+    std::vector<char> initial;
+    if (!pipelineCachePath_.empty()) {
+        std::ifstream in(pipelineCachePath_, std::ios::binary);
+        initial.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    }
+    VkPipelineCacheCreateInfo cacheInfo{VK_STRUCTURE_TYPE_PIPELINE_CACHE_CREATE_INFO};
+    cacheInfo.initialDataSize = initial.size();
+    cacheInfo.pInitialData = initial.empty() ? nullptr : initial.data();
+    if (vkCreatePipelineCache(device_, &cacheInfo, nullptr, &pipelineCache_) != VK_SUCCESS) {
+        cacheInfo.initialDataSize = 0;  // unreadable data: start empty
+        cacheInfo.pInitialData = nullptr;
+        check(vkCreatePipelineCache(device_, &cacheInfo, nullptr, &pipelineCache_), "vkCreatePipelineCache");
     }
 }
 

@@ -139,6 +139,10 @@ public:
     static std::vector<DeviceReport> listDevices();
 
 private:
+    int chooseDevice(const std::vector<VkPhysicalDevice>& devices, const ContextOptions& options,
+                     std::uint32_t& family);
+    void createDevice(const std::vector<std::string>& extensions);
+    void openPipelineCache(const std::string& path);
     std::uint32_t findMemoryType(std::uint32_t typeBits, VkMemoryPropertyFlags required,
                                  VkMemoryPropertyFlags preferred) const;
     void release();
