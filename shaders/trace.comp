@@ -774,8 +774,16 @@ bool nextRay(uint slot, inout SlotState state, uvec2 pixel, out Ray ray) {
     return false;
 }
 
-// The dispatch's constants (above) from the frame.
-void setDispatchConstants() {
+// The dispatch's constants (above) from the frame and the tile, its counts
+// zeroed, and the spheres of a small scene preloaded.
+void beginDispatch() {
+    invocations = gl_NumWorkGroups.x * uint(SNELL_WORKGROUP_SIZE);
+    tilePixels = tile.width * tile.height;
+    [[unroll]] for (int k = 0; k < SNELL_RAY_COUNTER_COUNT; ++k) countedRays[k] = 0u;
+    [[unroll]] for (uint i = 0u; i < SPHERE_COUNT; ++i) {
+        preloadedAnchor[i] = sphereAnchor(i);
+        preloadedNormal[i] = sphereNormal(i);
+    }
     // Mesa 22.3's lavapipe specialises a shader on values it reads from
     // uniforms with constant offsets where it judges that worthwhile
     // (lvp_inline_uniforms); for this kernel it judged so because of the
@@ -873,14 +881,7 @@ void addCounters(uint deepest) {
 
 void main() {
     uint slot = gl_GlobalInvocationID.x;
-    invocations = gl_NumWorkGroups.x * uint(SNELL_WORKGROUP_SIZE);
-    tilePixels = tile.width * tile.height;
-    [[unroll]] for (int k = 0; k < SNELL_RAY_COUNTER_COUNT; ++k) countedRays[k] = 0u;
-    [[unroll]] for (uint i = 0u; i < SPHERE_COUNT; ++i) {
-        preloadedAnchor[i] = sphereAnchor(i);
-        preloadedNormal[i] = sphereNormal(i);
-    }
-    setDispatchConstants();
+    beginDispatch();
 
     // This invocation's progress: its current pixel, that pixel's sum, and the
     // rays on its stack and in its frontier. Fresh, or resumed from the last
