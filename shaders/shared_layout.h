@@ -78,7 +78,8 @@ using uint = std::uint32_t;
 #define SNELL_SPEC_SPHERES_IN_BLOCK 14
 #define SNELL_SPEC_FRONTIER 15
 #define SNELL_SPEC_COUNT_LANES 16  // count the SIMD lanes busy in each loop pass (render --count-lanes)
-#define SNELL_SPEC_COUNT 17
+#define SNELL_SPEC_TRAPS 17        // some material traps light (render/Truncation.h, growthTraps)
+#define SNELL_SPEC_COUNT 18
 
 // Slots of the counters buffer: rays by kind, then per-dispatch bookkeeping.
 #define SNELL_COUNTER_PRIMARY 0
@@ -146,7 +147,9 @@ struct Ellipsoid {
     vec4 row2;
 };
 
-// SPEC §2/§4 material: kd.w is the Phong exponent, kt.w the index of refraction.
+// SPEC §2/§4 material: kd.w is the Phong exponent, kt.w the index of
+// refraction; ks.w is 1 where light can grow without end through it
+// (render/Truncation.h, growthTraps), else 0.
 struct Material {
     vec4 kd;
     vec4 ks;
@@ -193,7 +196,7 @@ struct SlotState {
     uint frontierHead;   // the frontier's first entry
     uint frontierCount;  // its entries
     uint frontierOld;    // of those, the ones the last step left, still to trace in this one
-    uint amplified;      // 1: a hit of its trees gained weight (ks + kt > 1 where the ray carried light)
+    uint amplified;      // 1: its trees met a trap (a material that can grow light without end, ks.w) with light
     float cutOff;        // this step's cut-off
     float heaviestLeft;  // the heaviest ray this step left in the frontier
     float lastMove;      // how far the last step moved the colour (ErrorEstimate)
@@ -250,7 +253,7 @@ struct FrameParams {
     uint estimate;      // 1: an unbounded pixel stops on its estimated error (TraceSettings::estimate)
     float minWeight;    // the weight cut-off (with a tolerance: the floor, the lowest cut-off tried)
     float tolerance;    // on each pixel's truncation bound; 0: none (a fixed tree)
-    float amplifiedEstimate;  // the estimated error within which a pixel whose trees gained weight may
+    float amplifiedEstimate;  // the estimated error within which a pixel whose trees met a trap may
                               // stop (render/Truncation.h, kAmplifiedEstimate)
     float airEta;       // the index of refraction outside every sphere (SPEC §4.5)
     uint pad0;

@@ -59,6 +59,10 @@ void countLanes(bool busy, inout uint slots, inout uint used) {
 layout(constant_id = SNELL_SPEC_MAX_MEDIA) const int MAX_MEDIA = 1;
 layout(constant_id = SNELL_SPEC_RAY_STACK) const uint RAY_STACK = 1u;
 layout(constant_id = SNELL_SPEC_AMPLIFYING) const bool AMPLIFYING = false;
+// Some material traps light, where it grows without end (ks.w of a material;
+// render/Truncation.h, growthTraps): a pixel whose trees meet one may go on
+// below the floor, so rays under the floor wait rather than being lost.
+layout(constant_id = SNELL_SPEC_TRAPS) const bool TRAPS = false;
 // Entries of an invocation's frontier: the rays a step leaves under its
 // cut-off, which the next step traces on (0: a fixed tree, nothing deferred).
 layout(constant_id = SNELL_SPEC_FRONTIER) const uint FRONTIER = 0u;
@@ -388,12 +392,15 @@ Ray popRay(uint slot, inout uint pending) {
 }
 
 // A ray under the cut-off (its medium stack in `media`) waits in the frontier
-// for the pixel's next step; one under the floor is lost for good, but in an
-// amplifying scene, where a pixel may need to go below it (main), it waits.
+// for the pixel's next step; one under the floor is lost for good, but in a
+// scene with traps, where a pixel may need to go below it (nextCutOff), it
+// waits. (Only there: elsewhere storing rays that no step traces cost more
+// than tracing the rest.)
 void deferRay(uint slot, inout SlotState state, Ray r) {
     float m = max(r.weight.r, max(r.weight.g, r.weight.b));
     if (!(m > 0.0)) return;
-    if (FRONTIER > 0u && state.frontierCount < FRONTIER && (AMPLIFYING || m >= frame.minWeight)) {
+    bool mayGoBelowFloor = TRAPS && frame.treeBudget != 0u;
+    if (FRONTIER > 0u && state.frontierCount < FRONTIER && (mayGoBelowFloor || m >= frame.minWeight)) {
         storeRay(frontierEntry(slot, state.frontierHead + state.frontierCount), r);
         state.frontierCount++;
         state.deferred.rgb += r.weight;
@@ -546,15 +553,17 @@ uint crossSurface(Hit h, uint count, uint removeAt) {
     return count;
 }
 
-// Light carried into a material of ks + kt > 1 (SPEC §4 amplifying
-// materials) can grow: an orbit of total internal reflection repeats its
-// angle for ever, and a path of tiny weight that enters one grows until its
-// channel saturates. The pixel's series may diverge behind steps that seem to
-// settle, so its estimated error must be within kAmplifiedEstimate
-// (render/Truncation.h; assessStep): a hit of such a gain, where the ray
-// carried light, marks the pixel.
-void noteGain(inout SlotState state, vec3 gain, vec3 weight) {
-    if (AMPLIFYING && any(bvec3(uvec3(greaterThan(gain, vec3(1.0))) & uvec3(greaterThan(weight, vec3(0.0))))))
+// Light carried into a material that traps it (SPEC §4 amplifying materials;
+// render/Truncation.h, growthTraps: an orbit of total internal reflection
+// that gains at every bounce) grows until its channel saturates, and a path
+// of tiny weight that enters one does too. The pixel's series may diverge
+// behind steps that seem to settle, so its estimated error must be within
+// kAmplifiedEstimate (assessStep) and it goes on below the floor
+// (nextCutOff): a hit of such a material, of gain > 1 in a channel where the
+// ray carried light, marks the pixel.
+void noteGain(inout SlotState state, Hit h, vec3 gain, vec3 weight) {
+    if (TRAPS && h.ks.w != 0.0 &&
+        any(bvec3(uvec3(greaterThan(gain, vec3(1.0))) & uvec3(greaterThan(weight, vec3(0.0))))))
         state.amplified = 1u;
 }
 
@@ -571,7 +580,7 @@ bool spawnChildren(uint slot, inout SlotState state, inout Ray r, vec3 weight, H
     }
     rvec3 d = r.dir;
     rvec3 n = h.normal;
-    noteGain(state, reflectedGain + (HAS_REFRACTION ? h.kt.rgb : vec3(0.0)), weight);
+    noteGain(state, h, reflectedGain + (HAS_REFRACTION ? h.kt.rgb : vec3(0.0)), weight);
     vec3 reflectedWeight = min(weighted(weight, reflectedGain), vec3(MAX_WEIGHT));
     bool transmits = false;  // a refracted ray exists (no total internal reflection)
     rvec3 refracted = rvec3(0.0);
@@ -703,7 +712,7 @@ StepOutcome assessStep(inout SlotState state) {
 float nextCutOff(SlotState state, StepOutcome o) {
     float heaviest = state.heaviestLeft;
     if (!(tolerance > 0.0) || o.certified || o.settled || !(heaviest > 0.0) || state.overBudget != 0u) return 0.0;
-    bool belowFloor = AMPLIFYING && o.unbounded && state.amplified != 0u && pixelBudget != 0u;
+    bool belowFloor = TRAPS && o.unbounded && state.amplified != 0u && pixelBudget != 0u;
     float next = cutOffRung(heaviest) / 16.0;
     if (!belowFloor) next = max(floorCutOff, next);
     return next <= heaviest ? next : 0.0;

@@ -86,3 +86,14 @@ for f in fail: print("FAIL:", f)
 print(f"bench: {len(d['results'])} settings checked, {len(fail)} problems")
 sys.exit(1 if fail else 0)
 PY
+status=$?
+# --no-scaling: the scenes given, and no scaling curve.
+"$SNELL" bench --quick --no-scaling --source-dir "$SOURCE" -o "$out/one" "$SOURCE/scenes/basic.scn" 2>"$out/one.log" ||
+  { cat "$out/one.log"; echo "FAIL: bench --no-scaling"; exit 1; }
+"$PYTHON" -c '
+import json, sys
+d = json.load(open(sys.argv[1]))
+scenes = {r["scene"] for r in d["results"]}
+sys.exit(0 if d["scaling"] == [] and len(scenes) == 1 else "FAIL: --no-scaling: %s, scenes %s" % (d["scaling"], scenes))
+' "$out/one/bench.json" || exit 1
+exit $status

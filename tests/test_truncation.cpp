@@ -43,6 +43,60 @@ TEST(RadianceBound, InfiniteWhereLightNeedNotDecay) {
     EXPECT_FALSE(b.finite());
 }
 
+// growthTraps, one material a sphere: whether light can grow without end.
+std::vector<bool> traps(const std::string& spheres, glm::dvec3 eye = {0.0, 0.0, 1.0}) {
+    return snell::growthTraps(parse("view 8 1\nlight 1 1 1 0 0 5\n" + spheres), eye);
+}
+const std::string kGlass = "material 0 0 0 0.05 0.05 0.05 10\nrefraction 0.95 0.95 0.95 1.5\n";
+const std::string kAmplifyingWater = "material 0 0 0 0.05 0.05 0.05 10\nrefraction 1 1 1 1.33\n";
+std::string sphereAt(double z, double radius) {
+    return "group\nmove 0 0 " + std::to_string(z) + "\nscale " + std::to_string(radius) + " " +
+           std::to_string(radius) + " " + std::to_string(radius) + "\nsphere\ngroupend\n";
+}
+
+const std::string kOpaque = "material 0.5 0.5 0.5 0 0 0 10\n";
+const std::string kEllipsoid = "group\nmove 0 0 -5\nscale 0.5 0.4 0.5\nsphere\ngroupend\n";
+
+TEST(GrowthTraps, AnOrbitOfTotalInternalReflectionInsideAnAmplifyingSphere) {
+    // Alone in air, ks + kt = 1.05: a ray refracted in meets the far side at
+    // the angle it came in at, below the critical one; nothing orbits.
+    EXPECT_EQ(traps(kAmplifyingWater + sphereAt(-5, 1)), std::vector<bool>{false});
+    // A ball inside turns rays past the critical angle: they orbit, gaining.
+    EXPECT_EQ(traps(kAmplifyingWater + sphereAt(-5, 1) + kOpaque + sphereAt(-5, 0.3)),
+              (std::vector<bool>{true, false}));
+    // So do an eye inside (rays start at any angle) and an ellipsoid's shape.
+    EXPECT_EQ(traps(kAmplifyingWater + sphereAt(0, 3)), std::vector<bool>{true});
+    EXPECT_EQ(traps(kAmplifyingWater + kEllipsoid), std::vector<bool>{true});
+    // Where light only decays, or at an index no denser than air, nothing grows.
+    EXPECT_EQ(traps(kGlass + sphereAt(-5, 1) + kOpaque + sphereAt(-5, 0.3)), (std::vector<bool>{false, false}));
+    EXPECT_EQ(traps("material 0 0 0 0.05 0.05 0.05 10\nrefraction 1 1 1 1.0002926\n" + sphereAt(-5, 1) + kOpaque +
+                    sphereAt(-5, 0.3)),
+              (std::vector<bool>{false, false}));
+    // A single child that carries more than its ray grows light anywhere.
+    EXPECT_EQ(traps("material 0 0 0 1.2 0 0 10\n" + sphereAt(-5, 1)), std::vector<bool>{true});
+}
+
+TEST(GrowthTraps, TheMediumAroundIsTheSphereThatContainsIt) {
+    const std::string ball = kOpaque + sphereAt(-5, 0.2);  // turns rays inside the water
+    // Water (1.33) inside glass (1.5): leaving the water, a ray enters glass,
+    // which is denser; no total internal reflection, no orbit.
+    EXPECT_EQ(traps(kGlass + sphereAt(-5, 1) + kAmplifyingWater + sphereAt(-5, 0.5) + ball),
+              (std::vector<bool>{false, false, false}));
+    // An ellipsoid of water there: no orbit either.
+    EXPECT_EQ(traps(kGlass + sphereAt(-5, 1) + kAmplifyingWater + kEllipsoid), (std::vector<bool>{false, false}));
+    // Inside a sphere of a lower index the orbit exists again.
+    const std::string thin = "material 0 0 0 0.05 0.05 0.05 10\nrefraction 0.9 0.9 0.9 1.2\n";
+    EXPECT_EQ(traps(thin + sphereAt(-5, 1) + kAmplifyingWater + sphereAt(-5, 0.5) + ball),
+              (std::vector<bool>{false, true, false}));
+    // The eye inside the glass: primary rays start in air (SPEC §4.5), so a
+    // ray in the water may leave it for air.
+    EXPECT_EQ(traps(kGlass + sphereAt(-5, 10) + kAmplifyingWater + sphereAt(-5, 0.5) + ball),
+              (std::vector<bool>{false, true, false}));
+    // The water's surface crossing the glass's: part of it faces air.
+    EXPECT_EQ(traps(kGlass + sphereAt(-5, 1) + kAmplifyingWater + sphereAt(-4.2, 0.5)),
+              (std::vector<bool>{false, true}));
+}
+
 TEST(PixelEstimate, ClampedToTheHeadroomAndZeroWhenSaturated) {
     snell::RadianceBound b;
     b.radiance = glm::dvec3(2.0, std::numeric_limits<double>::infinity(), 1.0);

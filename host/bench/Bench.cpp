@@ -974,7 +974,7 @@ void runBench(const BenchOptions& o, std::ostream& log) {
         if (o.cancel && o.cancel->load()) throw BenchError("cancelled");
         benchScene(context, o, file, size, runs, collected, log);
     }
-    collected.scaling = measureScaling(context, o, runs, log);
+    if (o.scaling) collected.scaling = measureScaling(context, o, runs, log);
 
     writeCsv(fs::path(o.outDir) / "bench.csv", collected, ceiling);
     writeJson(fs::path(o.outDir) / "bench.json", collected, ceiling, context, device, size, runs);

@@ -32,6 +32,7 @@ struct BenchOptions {
     std::string sharedDir;            // ../shared (course and bench scenes)
     std::string snellPath;            // this executable, for whole-command timings
     int gpu = -1;
+    bool scaling = true;              // the render time against sphere count, 10 to 10^6 spheres
     const std::atomic<bool>* cancel = nullptr;
 };
 

@@ -27,6 +27,8 @@ public:
                       "The snell repository (default: . if it has scenes/, else the build's)");
         c->add_option("--shared-dir", o_.sharedDir,
                       "Where course-scenes/ and bench-scenes/ are (default SOURCE/../shared)");
+        c->add_flag("--no-scaling", noScaling_,
+                    "Leave out the render time against sphere count (10 to 10^6 spheres, about a minute)");
         c->add_option("--gpu", o_.gpu, "Vulkan device index")->envname("SNELL_GPU")->check(CLI::NonNegativeNumber);
         return c;
     }
@@ -40,12 +42,14 @@ public:
         std::error_code ec;
         o_.snellPath = fs::read_symlink("/proc/self/exe", ec).string();
         o_.cancel = interruptFlag();
+        o_.scaling = !noScaling_;
         runBench(o_, std::cerr);
         return kExitSuccess;
     }
 
 private:
     BenchOptions o_;
+    bool noScaling_ = false;
 };
 
 }  // namespace

@@ -203,6 +203,7 @@ ComputeRenderer::Specialisation ComputeRenderer::specialise(const RenderRequest&
     values[SNELL_SPEC_RAY_STACK] =
         hasRefraction ? rayStackEntries(scene_, request.trace, hasReflection) + 1 : 1;  // + the suspended ray
     values[SNELL_SPEC_AMPLIFYING] = layout_.amplifying;
+    values[SNELL_SPEC_TRAPS] = layout_.traps;
     // Under a tolerance, a frontier for the rays a step leaves under its
     // cut-off; where it is full, rays are traced down to the floor instead.
     const bool secondaryRays = hasRefraction || hasReflection;

@@ -10,6 +10,8 @@
 #include "render/Truncation.h"
 
 namespace snell::gpu {
+static_assert(snell::kMediaStackLimit == SNELL_MAX_MEDIA_LIMIT);
+
 namespace {
 
 vec4 toVec4(const snell::dvec3& v, double w) {
@@ -168,8 +170,12 @@ GpuScene buildGpuScene(const snell::Scene& scene, const snell::Camera& camera, P
         out.sphereMaterials.push_back(s.material);
         if (wide) out.sphereLows.push_back(low);
     }
-    for (const snell::Material& m : scene.materials)
-        out.materials.push_back({toVec4(m.kd, m.phong), toVec4(m.ks, 0.0), toVec4(m.kt, m.eta)});
+    const std::vector<bool> traps = snell::growthTraps(scene, eye);
+    for (std::size_t i = 0; i < scene.materials.size(); ++i) {
+        const snell::Material& m = scene.materials[i];
+        out.materials.push_back({toVec4(m.kd, m.phong), toVec4(m.ks, traps[i] ? 1.0 : 0.0), toVec4(m.kt, m.eta)});
+        out.traps = out.traps || traps[i];
+    }
     out.amplifying = scene.anyAmplifying();
     for (const snell::Light& l : scene.lights) {
         Light light{}, low{};

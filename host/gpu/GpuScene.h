@@ -62,6 +62,7 @@ struct GpuScene {
     Precision precision = Precision::Fp32;
     std::size_t refractiveSpheres = 0;
     bool amplifying = false;
+    bool traps = false;  // some material traps light (render/Truncation.h, growthTraps)
     snell::dvec3 eye{0.0};       // the camera's eye
     snell::dvec3 origin{0.0};    // the world point that is the origin on the GPU
     double primaryStart = 0.0;   // distance from the eye at which primary rays start

@@ -120,15 +120,18 @@ struct CpuRenderer::TreeTrace {
     std::uint64_t budget = 0;     // the most rays they may trace; 0: no limit
     int deepest = 0;
     bool overBudget = false;
-    bool amplified = false;       // a hit gained weight (ks + kt > 1 where the ray carried light)
+    bool amplified = false;       // a hit met a trap (growthTraps) with light of a gain > 1
+    const std::vector<bool>* traps = nullptr;  // per material (growthTraps)
+    bool anyTrap = false;
 
     // A ray under the cut-off: the next, lower cut-off starts from it (under
-    // the floor no cut-off will, and it is lost; but in an amplifying scene a
+    // the floor no cut-off will, and it is lost; but in a scene with traps a
     // pixel may go below the floor, renderPixel).
-    void defer(PendingRay&& r, const TraceSettings& settings, bool amplifying) {
+    void defer(PendingRay&& r, const TraceSettings& settings) {
         const double m = maxComponent(r.weight);
         if (!(m > 0.0)) return;
-        if (!(settings.tolerance > 0.0) || (m < settings.minWeight && !amplifying)) {
+        const bool mayGoBelowFloor = anyTrap && settings.treeBudget != 0;
+        if (!(settings.tolerance > 0.0) || (m < settings.minWeight && !mayGoBelowFloor)) {
             lost += r.weight;
             return;
         }
@@ -148,6 +151,15 @@ CpuRenderer::CpuRenderer(const Scene& scene) : scene_(scene) {
         for (const Sphere& s : scene.spheres) bounds.push_back(sphereBounds(s));
         bvh_ = buildBvh(bounds);
     }
+}
+
+std::shared_ptr<const std::vector<bool>> CpuRenderer::trapsFor(const dvec3& eye) const {
+    const std::lock_guard<std::mutex> lock(trapsMutex_);
+    if (!traps_ || trapsEye_ != eye) {
+        traps_ = std::make_shared<const std::vector<bool>>(growthTraps(scene_, eye));
+        trapsEye_ = eye;
+    }
+    return traps_;
 }
 
 double CpuRenderer::intersect(std::uint32_t index, const Ray& ray, std::uint32_t fromSphere,
@@ -273,7 +285,7 @@ void CpuRenderer::spawnChildren(const PendingRay& r, const Material& m, std::uin
         const double mw = maxComponent(w);
         return mw > 0.0 && mw >= cutOff;
     };
-    auto defer = [&](PendingRay&& child) { tree.defer(std::move(child), settings, amplifying_); };
+    auto defer = [&](PendingRay&& child) { tree.defer(std::move(child), settings); };
     const dvec3 reflectedGain = settings.reflection ? m.ks : dvec3(0.0);
     const dvec3 transmittedGain = settings.refraction && m.refracts() ? m.kt : dvec3(0.0);
     if (r.depth >= settings.maxDepth) {
@@ -281,14 +293,15 @@ void CpuRenderer::spawnChildren(const PendingRay& r, const Material& m, std::uin
         return;
     }
 
-    // Light carried into a material of ks + kt > 1 (SPEC §4 amplifying
-    // materials) can grow: an orbit of total internal reflection repeats
-    // its angle for ever, and a path of tiny weight that enters one grows
-    // until its channel saturates. The pixel's series may diverge behind
-    // steps that seem to settle, so its estimated error must be within
-    // kAmplifiedEstimate.
-    for (int c = 0; c < 3; ++c)
-        if (reflectedGain[c] + transmittedGain[c] > 1.0 && r.weight[c] > 0.0) tree.amplified = true;
+    // Light carried into a material that traps it (SPEC §4 amplifying
+    // materials; growthTraps: an orbit of total internal reflection that
+    // gains at every bounce) grows until its channel saturates, and a path of
+    // tiny weight that enters one does too. The pixel's series may diverge
+    // behind steps that seem to settle, so its estimated error must be within
+    // kAmplifiedEstimate and it goes on below the floor (renderPixel).
+    if ((*tree.traps)[scene_.spheres[hitSphere].material])
+        for (int c = 0; c < 3; ++c)
+            if (reflectedGain[c] + transmittedGain[c] > 1.0 && r.weight[c] > 0.0) tree.amplified = true;
     dvec3 reflectedWeight = childWeight(r.weight, reflectedGain);
     std::optional<PendingRay> refractedRay;
     if (settings.refraction && m.refracts()) {
@@ -330,7 +343,7 @@ void CpuRenderer::trace(const PendingRay& root, dvec3& pixelSum, double saturati
         const double m = maxComponent(w);
         return m > 0.0 && m >= cutOff;
     };
-    auto defer = [&](PendingRay&& r) { tree.defer(std::move(r), settings, amplifying_); };
+    auto defer = [&](PendingRay&& r) { tree.defer(std::move(r), settings); };
     while (!stack.empty()) {
         PendingRay r = std::move(stack.back());
         stack.pop_back();
@@ -396,6 +409,9 @@ CpuRenderer::Pixel CpuRenderer::renderPixel(const RenderRequest& request, int x,
     dvec3 sum(0.0);
     TreeTrace tree;
     tree.budget = settings.treeBudget * std::uint64_t(count);
+    const std::shared_ptr<const std::vector<bool>> traps = trapsFor(request.camera.eye);
+    tree.traps = traps.get();
+    tree.anyTrap = std::find(traps->begin(), traps->end(), true) != traps->end();
     const bool continues = settings.tolerance > 0.0;
     for (int k = first; k < first + count; ++k) {
         // SPEC §3: sub-pixel (a, b) at x = i + (a + ½)/s, y = j + (b + ½)/s.

@@ -4,6 +4,9 @@
 // shader's trace() in shaders/trace.comp: same ray tree, same order.
 #pragma once
 
+#include <memory>
+#include <mutex>
+#include <vector>
 
 #include "bvh/Bvh.h"
 #include "render/RenderRequest.h"
@@ -49,11 +52,17 @@ private:
     bool occluded(const Ray& ray, double distance, std::uint32_t fromSphere, StartsOn start) const;
     double intersect(std::uint32_t sphere, const Ray& ray, std::uint32_t fromSphere, StartsOn start) const;
 
+    // growthTraps for a render's eye, kept for the next render from there.
+    std::shared_ptr<const std::vector<bool>> trapsFor(const glm::dvec3& eye) const;
+
     const Scene& scene_;
     Bvh bvh_;
     bool useBvh_ = false;
     bool amplifying_ = false;
     RadianceBound radiance_;
+    mutable std::mutex trapsMutex_;
+    mutable std::shared_ptr<const std::vector<bool>> traps_;
+    mutable glm::dvec3 trapsEye_{0.0};
 };
 
 }  // namespace snell

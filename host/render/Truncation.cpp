@@ -73,6 +73,95 @@ double ErrorEstimate::error() const {
     return std::max(lastWeight, lastChange > 0.0 ? lastChange / (1.0 - rho) : 0.0);
 }
 
+namespace {
+
+// A ball that holds a sphere or an ellipsoid: itself, or a centre and the
+// Frobenius norm of the linear part (at least its longest semi-axis).
+struct Ball {
+    glm::dvec3 centre{0.0};
+    double radius = 0.0;
+};
+Ball boundingBall(const Sphere& s) {
+    if (s.isTrueSphere) return {s.centre, s.radius};
+    double squares = 0.0;
+    for (int c = 0; c < 3; ++c) squares += glm::dot(glm::dvec3(s.worldFromObject[c]), glm::dvec3(s.worldFromObject[c]));
+    return {glm::dvec3(s.worldFromObject[3]), std::sqrt(squares)};
+}
+
+// How ball a lies against ball b: inside it, around it, apart, or their
+// surfaces cross (or touch, within rounding: treated as crossing).
+enum class Placement { Inside, Around, Apart, Crossing };
+Placement placement(const Ball& a, const Ball& b) {
+    const double d = glm::length(a.centre - b.centre);
+    const double margin = 1e-9 * (d + a.radius + b.radius);
+    if (d + a.radius < b.radius - margin) return Placement::Inside;
+    if (d + b.radius < a.radius - margin) return Placement::Around;
+    if (d > a.radius + b.radius + margin) return Placement::Apart;
+    return Placement::Crossing;
+}
+
+bool holds(const Ball& b, const glm::dvec3& point) {  // or nearly, as rounding has it
+    return glm::length(point - b.centre) <= b.radius * (1.0 + 1e-9);
+}
+
+// Sphere pairs the analysis looks at before it takes every sphere for a trap.
+constexpr double kMaxPairs = 1e8;
+
+// Whether an orbit of total internal reflection can form inside sphere i
+// (growthTraps): a ray inside it must meet its surface at more than the
+// critical angle, so something must turn rays inside it, and a ray leaving
+// it must enter a medium of a lower refractive index.
+bool orbitInside(const Scene& scene, std::size_t i, const glm::dvec3& eye) {
+    const Sphere& s = scene.spheres[i];
+    const Ball ball = boundingBall(s);
+    // An ellipsoid's chords meet its surface at changing angles; rays from an
+    // eye inside start at any angle.
+    bool turned = !s.isTrueSphere || holds(ball, eye);
+    bool air = false;  // a ray leaving it may enter air
+    double least = std::numeric_limits<double>::infinity();
+    int containers = 0;
+    for (std::size_t j = 0; j < scene.spheres.size(); ++j) {
+        if (j == i) continue;
+        const Sphere& q = scene.spheres[j];
+        const Placement p = placement(ball, boundingBall(q));
+        if (p == Placement::Apart) continue;
+        // Any surface in it (an opaque one too) can turn a ray.
+        if (p != Placement::Inside || !q.isTrueSphere) turned = true;
+        const Material& m = scene.materials[q.material];
+        if (!m.refracts() || p == Placement::Around) continue;  // not a medium around it
+        least = std::min(least, m.eta);
+        if (p == Placement::Inside && q.isTrueSphere) {
+            ++containers;
+            // Primary rays start in air even inside a sphere (SPEC §4.5):
+            // their stack lacks it, and a ray leaving may enter air.
+            if (holds(boundingBall(q), eye)) air = true;
+        }
+    }
+    // Without a sphere around it every surface point may face air; a stack
+    // deeper than any renderer keeps forgets its outermost medium.
+    if (containers == 0 || containers >= kMediaStackLimit) air = true;
+    if (air) least = std::min(least, kAirEta);
+    return turned && scene.materials[s.material].eta > least;
+}
+
+}  // namespace
+
+std::vector<bool> growthTraps(const Scene& scene, const glm::dvec3& eye) {
+    std::vector<bool> traps(scene.materials.size(), false);
+    std::size_t candidates = 0;
+    for (const Sphere& s : scene.spheres) candidates += scene.materials[s.material].amplifies();
+    const bool tooMany = double(candidates) * double(scene.spheres.size()) > kMaxPairs;
+    for (std::size_t i = 0; i < scene.spheres.size(); ++i) {
+        const Material& m = scene.materials[scene.spheres[i].material];
+        if (traps[scene.spheres[i].material]) continue;
+        bool grows = false;  // one child carries more than its ray
+        for (int c = 0; c < 3; ++c) grows = grows || m.ks[c] > 1.0 || m.kt[c] > 1.0;
+        traps[scene.spheres[i].material] =
+            grows || (m.refracts() && m.amplifies() && (tooMany || orbitInside(scene, i, eye)));
+    }
+    return traps;
+}
+
 TreeSizeBound treeSizeBound(const Scene& scene, int maxDepth, double minWeight) {
     TreeSizeBound b;
     bool branches = false;  // a hit can have two children

@@ -73,10 +73,36 @@ struct ErrorEstimate {
     double error() const;  // +inf while unknown (fewer than three steps) or not shrinking
 };
 
-// A pixel whose trees gained weight (SPEC §4 amplifying materials) may hide a
-// diverging series behind steps that seem to settle: it stops on its estimated
-// error only within this as well as the tolerance (1/100 of an 8-bit step, the
-// limit reference's tolerance).
+// Where light can grow without end (SPEC §4 amplifying materials), per
+// material. A ray's weight grows only at a hit whose one child carries more
+// than the ray: a reflection of ks > 1, a refraction of kt > 1, or a total
+// internal reflection, which carries ks + kt. Growing without end takes such
+// hits over and over, and a sphere makes that certain in one way: inside it,
+// every chord meets the surface at the angle of the last one, so a ray once
+// reflected totally inside it is reflected totally for ever, gaining at every
+// bounce where ks + kt > 1 (an orbit). That needs a refractive index above
+// that of the medium a ray leaving the sphere enters (by the medium stack,
+// SPEC §4.5: a refractive sphere around it or crossing it, else air), and a
+// ray inside it at more than the critical angle: one that a refraction into
+// it cannot make (it leaves at the angle it came in at), so something must
+// turn it there, a surface inside or across it, or the eye inside it; an
+// ellipsoid turns its own rays. Total internal reflection off a sphere from
+// outside sends the ray away, and a path repeats it only by way of other
+// surfaces at other angles, as chance has it: a transient, not an orbit (on
+// scenes/glass.scn, whose air bubble in water reflects so with
+// ks + kt = 1.05, no path grew by more than 4.3x). So a material "traps"
+// light where some sphere of it has ks > 1 or kt > 1 in a channel, or
+// ks + kt > 1 where such an orbit can form; placements are judged by bounding
+// balls, and what is not sure counts as a trap.
+std::vector<bool> growthTraps(const Scene& scene, const glm::dvec3& eye);
+// The deepest medium stack any renderer keeps (the shader's,
+// SNELL_MAX_MEDIA_LIMIT); deeper, the outermost medium is forgotten.
+inline constexpr int kMediaStackLimit = 16;
+
+// A pixel whose trees met a trap (growthTraps) may hide a diverging series
+// behind steps that seem to settle: it stops on its estimated error only
+// within this as well as the tolerance (1/100 of an 8-bit step, the limit
+// reference's tolerance), and goes on below the floor until it saturates.
 inline constexpr double kAmplifiedEstimate = 0.01 / 255.0;
 
 // The most rays one sample's tree can hold under a depth limit D, a weight
