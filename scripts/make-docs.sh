@@ -123,6 +123,12 @@ prints; the same as
 of render, preview and bench, which wins when both are given. Unset: the
 best device found.
 .TP
+.B SNELL_TRAVERSAL
+How render and preview search scenes with a BVH, the same as
+.BR \-\-traversal :
+bvh (snell's own walk), ray-query (the device's ray traversal,
+VK_KHR_ray_query), or auto (ray queries on a GPU that has them, else bvh).
+.TP
 .B SNELL_VALIDATION
 Set to 1, the same as
 .BR \-\-validation :

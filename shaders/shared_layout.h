@@ -59,6 +59,11 @@ using uint = std::uint32_t;
 #define SNELL_BINDING_LIGHTS_LOW 16
 #define SNELL_BINDING_RAY_STACK_LOW 17
 #define SNELL_BINDING_COUNT 18
+// The ray-query shader (fp32 only; --traversal ray-query) reads the spheres'
+// boxes as an acceleration structure (VK_KHR_acceleration_structure), the
+// driver's own traversal in place of the BVH walk: one geometry of AABBs,
+// primitive i the box of sphere i, in one instance.
+#define SNELL_BINDING_ACCELERATION 18
 
 // Specialization constants: compile only what a scene uses.
 #define SNELL_SPEC_USE_BVH 0

@@ -18,6 +18,9 @@
 #extension GL_KHR_shader_subgroup_arithmetic : require
 #extension GL_EXT_control_flow_attributes : require
 #extension GL_EXT_samplerless_texture_functions : require
+#ifdef SNELL_RAY_QUERY
+#extension GL_EXT_ray_query : require
+#endif
 #include "shared_layout.h"
 #include "intersect.glsl"
 
@@ -87,6 +90,9 @@ layout(set = 0, binding = SNELL_BINDING_ELLIPSOIDS) uniform textureBuffer ellips
 layout(set = 0, binding = SNELL_BINDING_MATERIALS) uniform textureBuffer materialTexels;
 layout(set = 0, binding = SNELL_BINDING_LIGHTS) uniform textureBuffer lightTexels;
 layout(set = 0, binding = SNELL_BINDING_BVH) uniform utextureBuffer bvhTexels;
+#ifdef SNELL_RAY_QUERY
+layout(set = 0, binding = SNELL_BINDING_ACCELERATION) uniform accelerationStructureEXT sphereBoxes;
+#endif
 #ifdef SNELL_FP64
 layout(set = 0, binding = SNELL_BINDING_SPHERE_BLOCK, std140) uniform SphereUniforms {
     SphereBlock small;
@@ -240,11 +246,49 @@ uint traverseBvh(rvec3 origin, real originLength, rvec3 dir, uint fromSphere, ui
     return hit;
 }
 
+#ifdef SNELL_RAY_QUERY
+// The same search through the driver's traversal (VK_KHR_ray_query; on a GPU
+// with ray-tracing hardware, that hardware): it reports each sphere whose box
+// (rounded outwards, so it holds the sphere) the ray enters within tHit, and
+// the exact test of intersect.glsl, with its no-epsilon rules, decides as in
+// the walk above. A hit nearer than tHit is handed back to the query, which
+// then culls the boxes beyond it.
+uint queryBoxes(rvec3 origin, real originLength, rvec3 dir, uint fromSphere, uint start, bool anyHit,
+                inout real tHit) {
+    rayQueryEXT query;
+    rayQueryInitializeEXT(query, sphereBoxes, gl_RayFlagsNoneEXT, 0xffu, origin, 0.0, dir, tHit);
+    uint hit = NONE;
+    while (rayQueryProceedEXT(query)) {
+        tick(1u);
+        if (COUNT_LANES) countLanes(true, walkSlots, walkBusy);
+        uint i = uint(rayQueryGetIntersectionPrimitiveIndexEXT(query, false));
+        real t = intersectSphere(i, origin, originLength, dir, fromSphere, start);
+        if (t < tHit) {
+            tHit = t;
+            hit = i;
+            rayQueryGenerateIntersectionEXT(query, t);
+            if (anyHit) rayQueryTerminateEXT(query);
+        }
+    }
+    return hit;
+}
+#endif
+
+// The BVH search of this build: the driver's traversal, else snell's walk.
+uint searchBvh(rvec3 origin, real originLength, rvec3 dir, uint fromSphere, uint start, bool anyHit,
+               inout real tHit) {
+#ifdef SNELL_RAY_QUERY
+    return queryBoxes(origin, originLength, dir, fromSphere, start, anyHit, tHit);
+#else
+    return traverseBvh(origin, originLength, dir, fromSphere, start, anyHit, tHit);
+#endif
+}
+
 // SPEC §4.1: the closest hit with t > 0; returns the sphere index or NONE.
 uint closestHit(rvec3 origin, rvec3 dir, uint fromSphere, uint start, out real tHit) {
     tHit = NO_HIT;
     real originLength = length(origin);
-    if (USE_BVH) return traverseBvh(origin, originLength, dir, fromSphere, start, false, tHit);
+    if (USE_BVH) return searchBvh(origin, originLength, dir, fromSphere, start, false, tHit);
     uint hit = NONE;
     if (SPHERE_COUNT > 0u) {
         [[unroll]] for (uint i = 0u; i < SPHERE_COUNT; ++i) {
@@ -265,7 +309,7 @@ uint closestHit(rvec3 origin, rvec3 dir, uint fromSphere, uint start, out real t
 // Stops at the first occluder.
 bool occluded(rvec3 origin, rvec3 dir, real distance, uint fromSphere, uint start) {
     real originLength = length(origin);
-    if (USE_BVH) return traverseBvh(origin, originLength, dir, fromSphere, start, true, distance) != NONE;
+    if (USE_BVH) return searchBvh(origin, originLength, dir, fromSphere, start, true, distance) != NONE;
     bool blocked = false;
     if (SPHERE_COUNT > 0u) {
         [[unroll]] for (uint i = 0u; i < SPHERE_COUNT; ++i) {

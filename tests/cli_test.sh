@@ -264,5 +264,26 @@ assert 0 < lanes["trace_busy"] <= lanes["trace_slots"] and 0 < lanes["trace_occu
 assert 0 < lanes["walk_busy"] <= lanes["walk_slots"] and 0 < lanes["walk_occupancy"] <= 1, lanes
 PY
 
+# --traversal: --stats names the search that ran; ray queries, where the
+# device has them, trace the very image of snell's walk, and where it has
+# none (Mesa 22.3's lavapipe) they are refused with the reason, status 1.
+"$SNELL" render "$SCENES/grid.scn" --size 32 -q -o "$work/walk.pfm" --traversal bvh --stats >"$work/stats" &&
+  grep -q '"traversal": "bvh"' "$work/stats" && ok || bad "--traversal bvh: $(tail -n 1 "$work/stats")"
+"$SNELL" render "$SCENES/basic.scn" --size 32 -q -o "$work/loop.pfm" --stats >"$work/stats" &&
+  grep -q '"traversal": "loop"' "$work/stats" && ok || bad "one sphere is not a loop: $(tail -n 1 "$work/stats")"
+"$SNELL" render "$SCENES/grid.scn" --size 32 -q -o "$work/query.pfm" --traversal ray-query --stats >"$work/stats" 2>"$work/err"
+status=$?
+if "$SNELL" devices | grep -q "no ray queries"; then
+  [ $status -eq 1 ] && grep -q "ray-query: the device lacks VK_KHR_" "$work/err" && ok ||
+    bad "--traversal ray-query without ray queries: status $status, $(cat "$work/err")"
+else
+  [ $status -eq 0 ] && grep -q '"traversal": "ray-query"' "$work/stats" && cmp -s "$work/walk.pfm" "$work/query.pfm" && ok ||
+    bad "--traversal ray-query: status $status, $(cat "$work/err") $(tail -n 1 "$work/stats")"
+fi
+"$SNELL" render "$SCENES/grid.scn" --size 8 --traversal ray-query --precision fp64 -o "$work/x.png" 2>"$work/err"
+[ $? -eq 1 ] && grep -q "fp32" "$work/err" && ok || bad "--traversal ray-query with fp64: $(cat "$work/err")"
+"$SNELL" render "$SCENES/grid.scn" --size 8 --traversal rtx -o "$work/x.png" 2>/dev/null
+[ $? -eq 2 ] && ok || bad "--traversal rtx accepted"
+
 echo "cli: $pass passed, $fail failed"
 [ $fail -eq 0 ]

@@ -1,6 +1,7 @@
 // The Vulkan context shared by the GPU tests of one test executable. No device
 // is a failure, never a skip; with SNELL_VALIDATION=1 the Khronos validation
-// layer watches every test.
+// layer watches every test. Ray queries are enabled where the device has them
+// (renderers still walk snell's BVH on lavapipe unless asked otherwise).
 #pragma once
 
 #include <cstdlib>
@@ -16,6 +17,7 @@ inline vk::Context& gpuContext() {
         vk::ContextOptions options;
         const char* validation = std::getenv("SNELL_VALIDATION");
         options.validation = validation && std::string(validation) == "1";
+        options.rayQueries = vk::RayQueries::On;
         return std::make_unique<vk::Context>(options);
     }();
     return *context;

@@ -1,6 +1,8 @@
 // GPU (float32 compute shader, default settings) against the CPU reference
 // (double, converged settings) on every scene in scenes/ and in the course's
-// scene files, and the fp64 shader (--precision fp64) on the hard cases. Runs on lavapipe in CI and is never skipped: no Vulkan device is
+// scene files, the fp64 shader (--precision fp64) on the hard cases, and the
+// device's ray traversal (--traversal ray-query) on the hard cases and the BVH
+// scenes. Runs on lavapipe in CI and is never skipped: no Vulkan device is
 // a failure. On failure the GPU image, the reference and a difference image are
 // written to build/test-artifacts/ and named in the message.
 #include <chrono>
@@ -44,11 +46,16 @@ struct Case {
     // speckles (chaotic multi-bounce pixels in becker-1n) are reported only.
     bool noSpeckles = true;
     snell::gpu::Precision precision = snell::gpu::Precision::Fp32;
+    snell::gpu::Traversal traversal = snell::gpu::Traversal::Walk;
 };
 
-void PrintTo(const Case& c, std::ostream* os) {
-    *os << c.path << (c.precision == snell::gpu::Precision::Fp64 ? " (fp64)" : "");
+const char* suffix(const Case& c) {
+    return c.precision == snell::gpu::Precision::Fp64        ? "_fp64"
+           : c.traversal == snell::gpu::Traversal::RayQuery ? "_ray_query"
+                                                              : "";
 }
+
+void PrintTo(const Case& c, std::ostream* os) { *os << c.path << suffix(c); }
 
 std::vector<Case> allCases() {
     std::vector<Case> cases;
@@ -64,8 +71,18 @@ std::vector<Case> allCases() {
         const std::string name = fs::path(p).stem().string();
         c.noSpeckles = p.find("/course-scenes/") == std::string::npos;
         cases.push_back(c);
-        if (p.find("/scenes/hard/") != std::string::npos) {
-            c.precision = snell::gpu::Precision::Fp64;
+        const bool hard = p.find("/scenes/hard/") != std::string::npos;
+        if (hard) {
+            Case fp64 = c;
+            fp64.precision = snell::gpu::Precision::Fp64;
+            cases.push_back(fp64);
+        }
+        // The ray-query traversal where its float ray-box test is tested
+        // hardest (the hard cases, searched through it from two spheres up)
+        // and where it replaces the BVH walk.
+        const std::size_t spheres = snell::parseSceneFile(p).spheres.size();
+        if (spheres >= 2 && (hard || spheres > snell::gpu::kBvhThreshold)) {
+            c.traversal = snell::gpu::Traversal::RayQuery;
             cases.push_back(c);
         }
     }
@@ -76,8 +93,7 @@ snell::vk::Context& context() { return snell::testing::gpuContext(); }
 
 std::string testName(const testing::TestParamInfo<Case>& info) {
     std::string n = fs::path(info.param.path).parent_path().filename().string() + "_" +
-                    fs::path(info.param.path).stem().string() +
-                    (info.param.precision == snell::gpu::Precision::Fp64 ? "_fp64" : "");
+                    fs::path(info.param.path).stem().string() + suffix(info.param);
     for (char& c : n)
         if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
     return n;
@@ -141,7 +157,22 @@ TEST_P(GpuAgreement, MatchesCpuReference) {
     request.boundImage = &gpuBound;
 
     const std::uint32_t messagesBefore = context().validationMessages();
-    snell::ComputeRenderer gpuRenderer(context(), scene, request.camera, c.precision);
+    if (c.traversal == snell::gpu::Traversal::RayQuery && !context().rayQueriesEnabled()) {
+        // A driver without ray queries (Mesa 22.3's lavapipe) refuses them, saying why.
+        try {
+            snell::ComputeRenderer refused(context(), scene, request.camera, c.precision, snell::gpu::BvhMode::Auto,
+                                           c.traversal);
+            ADD_FAILURE() << "--traversal ray-query accepted on a device without ray queries";
+        } catch (const snell::vk::VulkanError& e) {
+            EXPECT_NE(std::string(e.what()).find("VK_KHR_"), std::string::npos) << e.what();
+        }
+        return;
+    }
+    snell::ComputeRenderer gpuRenderer(context(), scene, request.camera, c.precision, snell::gpu::BvhMode::Auto,
+                                       c.traversal);
+    const bool bvh = scene.spheres.size() > snell::gpu::kBvhThreshold;
+    EXPECT_STREQ(gpuRenderer.traversal(),
+                 c.traversal == snell::gpu::Traversal::RayQuery ? "ray-query" : bvh ? "bvh" : "loop");
     const snell::GpuRenderResult gpu = gpuRenderer.render(request, false);
     EXPECT_EQ(context().validationMessages(), messagesBefore) << "the Vulkan validation layer reported messages";
 

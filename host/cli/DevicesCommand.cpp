@@ -8,6 +8,13 @@
 namespace snell::cli {
 namespace {
 
+// Which search of BVH scenes --traversal auto takes on the device, and why.
+std::string traversal(const vk::DeviceReport& r) {
+    if (!r.rayQueries) return "; traversal: bvh (no ray queries)";
+    return r.type == "CPU" ? "; traversal: bvh (ray queries too: --traversal ray-query; slower here)"
+                           : "; traversal: ray-query (--traversal bvh for snell's walk)";
+}
+
 class DevicesCommand : public Command {
 public:
     CLI::App* define(CLI::App& app) override {
@@ -19,7 +26,8 @@ public:
         if (reports.empty()) throw std::runtime_error("no Vulkan device found: apt-get install mesa-vulkan-drivers");
         for (const auto& r : reports)
             std::cout << r.index << ": " << r.name << " (" << r.type << ", " << r.driver << ")"
-                      << (r.usable ? "" : " — unusable: " + r.reason) << "\n";
+                      << (r.usable ? "" : " — unusable: " + r.reason)
+                      << (r.usable ? traversal(r) : "") << "\n";
         return kExitSuccess;
     }
 };

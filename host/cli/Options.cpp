@@ -36,9 +36,23 @@ void addDeviceOptions(CLI::App& command, DeviceOptions& o) {
     command.add_option("--precision", o.precision,
                        "GPU arithmetic for geometry: fp32 (default) or fp64 (needs shaderFloat64; slower)")
         ->check(CLI::IsMember({"fp32", "fp64"}));
+    command.add_option("--traversal", o.traversal,
+                       "How BVH scenes are searched: bvh (snell's walk), ray-query (the device's ray traversal, "
+                       "VK_KHR_ray_query; fp32), or auto (default: ray queries on GPUs that have them, else bvh)")
+        ->envname("SNELL_TRAVERSAL")->check(CLI::IsMember({"auto", "bvh", "ray-query"}));
     command.add_flag("--validation", o.validation,
                      "Enable the Khronos validation layer; any message it reports is an error")
         ->envname("SNELL_VALIDATION");
+}
+
+vk::ContextOptions DeviceOptions::context() const {
+    vk::ContextOptions options;
+    options.deviceIndex = gpu;
+    options.validation = validation;
+    options.rayQueries = traversal == "ray-query" ? vk::RayQueries::On
+                         : traversal == "bvh"     ? vk::RayQueries::Off
+                                                  : vk::RayQueries::OnGpus;
+    return options;
 }
 
 void addTreeOptions(CLI::App& command, TreeOptions& o, const TreeHelp& help) {

@@ -17,12 +17,20 @@ extern const CLI::Validator kImageFormat;
 // CLI11's Range lets NaN through (every comparison with it is false).
 extern const CLI::Validator kFinite;
 
-// Which Vulkan device renders, and how: --gpu, --precision, --validation.
+// Which Vulkan device renders, and how: --gpu, --precision, --traversal, --validation.
 struct DeviceOptions {
     int gpu = -1;
     std::string precision = "fp32";
+    std::string traversal = "auto";
     bool validation = false;
     gpu::Precision arithmetic() const { return precision == "fp64" ? gpu::Precision::Fp64 : gpu::Precision::Fp32; }
+    gpu::Traversal search() const {
+        return traversal == "ray-query" ? gpu::Traversal::RayQuery
+               : traversal == "bvh"     ? gpu::Traversal::Walk
+                                        : gpu::Traversal::Auto;
+    }
+    // The context these options ask for (ray queries enabled as --traversal needs).
+    vk::ContextOptions context() const;
 };
 void addDeviceOptions(CLI::App& command, DeviceOptions& options);
 

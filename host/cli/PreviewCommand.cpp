@@ -41,6 +41,8 @@ public:
         o_.gpu = device_.gpu;
         o_.validation = device_.validation;
         o_.precision = device_.arithmetic();
+        o_.traversal = device_.search();
+        o_.rayQueries = device_.context().rayQueries;
         o_.cancel = interruptFlag();
         o_.pipelineCachePath = pipelineCachePath();
         runPreview(o_);

@@ -93,6 +93,7 @@ double share(std::uint64_t part, std::uint64_t whole) { return whole ? double(pa
 struct RenderOutcome {
     RayCounts rays;
     std::string device;
+    std::string traversal = "reference";  // ComputeRenderer::traversal() on the GPU
     std::string timing = "host";  // how renderMs was measured
     double uploadMs = 0, pipelineMs = 0, renderMs = 0, readbackMs = 0;
     double estimateMs = 0;  // the progress bar's sparse render (estimateCost)
@@ -266,11 +267,12 @@ int RenderCommand::run() {
     if (!o_.quiet) printTruncationWarnings(truncation_, request.trace);
     if (o_.verbose)
         std::fprintf(stderr,
-                     "snell: %s: %dx%d, %s on %s\n"
+                     "snell: %s: %dx%d, %s (%s) on %s\n"
                      "snell: parse %.1f ms, upload %.1f ms, pipeline %.1f ms, render %.1f ms (%s, %d tiles, %d "
                      "dispatches), readback %.1f ms, write %.1f ms (%.1f ms of it not overlapped)%s; %.1f ms in all\n",
                      output.c_str(), request.width, request.height,
-                     o_.cpu ? "CPU reference" : o_.device.precision.c_str(), outcome.device.c_str(), parseMs,
+                     o_.cpu ? "CPU reference" : o_.device.precision.c_str(), outcome.traversal.c_str(),
+                     outcome.device.c_str(), parseMs,
                      outcome.uploadMs, outcome.pipelineMs, outcome.renderMs, outcome.timing.c_str(), outcome.tiles,
                      outcome.dispatches, outcome.readbackMs, stream.encodeMs(), stream.blockedMs(),
                      outcome.estimateMs > 0 ? (", estimate " + std::to_string(int(outcome.estimateMs)) + " ms").c_str() : "",
@@ -365,14 +367,13 @@ RenderOutcome RenderCommand::renderOnGpu(const Scene& scene, RenderRequest& requ
                                          Progress& progress) const {
     try {
         RenderOutcome r;
-        vk::ContextOptions options;
-        options.deviceIndex = o_.device.gpu;
-        options.validation = o_.device.validation;
+        vk::ContextOptions options = o_.device.context();
         options.fault = faultInjection();
         options.pipelineCachePath = pipelineCachePath();
         vk::Context context(options);
         stream.encodeBeside(context.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU);
-        ComputeRenderer renderer(context, scene, request.camera, o_.device.arithmetic());
+        ComputeRenderer renderer(context, scene, request.camera, o_.device.arithmetic(), gpu::BvhMode::Auto,
+                                 o_.device.search());
         if (const std::uint32_t budget = loopBudgetOverride()) renderer.forceLoopBudget(budget);
         renderer.countLanes(o_.countLanes);
         // The probe compiles the pipeline (the same one: same settings), which belongs to pipelineMs.
@@ -385,6 +386,7 @@ RenderOutcome RenderCommand::renderOnGpu(const Scene& scene, RenderRequest& requ
                          });
         const GpuRenderResult g = renderer.render(request, o_.stats);
         r.device = context.deviceName();
+        r.traversal = renderer.traversal();
         r.uploadMs = renderer.uploadMs();
         r.rays = g.rays;
         r.renderMs = g.renderMs;
@@ -425,6 +427,7 @@ std::string RenderCommand::statsJson(const Scene& scene, const RenderRequest& re
     j << std::fixed << "{\"scene\": " << jsonString(o_.scene) << ", \"output\": " << jsonString(output)
       << ", \"backend\": \"" << (o_.cpu ? "cpu" : "gpu") << "\", \"device\": " << jsonString(r.device)
       << ", \"precision\": \"" << (o_.cpu ? "fp64-reference" : o_.device.precision) << "\""
+      << ", \"traversal\": \"" << r.traversal << "\""
       << ", \"width\": " << request.width << ", \"height\": " << request.height
       << ", \"supersample\": " << request.supersample << ", \"max_depth\": " << request.trace.maxDepth
       << ", \"min_weight\": " << request.trace.minWeight << ", \"spheres\": " << scene.spheres.size()

@@ -13,6 +13,7 @@
 #include "gpu/DriverProbe.h"
 #include "trace_comp_spv.h"       // generated at build time from shaders/trace.comp
 #include "trace_fp64_comp_spv.h"  // the same, compiled with SNELL_FP64
+#include "trace_ray_query_comp_spv.h"  // the same, compiled with SNELL_RAY_QUERY
 
 namespace snell {
 
@@ -38,6 +39,7 @@ VkDescriptorType descriptorType(std::uint32_t binding) {
     case SNELL_BINDING_SPHERES_LOW:
     case SNELL_BINDING_ELLIPSOIDS_LOW:
     case SNELL_BINDING_LIGHTS_LOW: return VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;
+    case SNELL_BINDING_ACCELERATION: return VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR;
     default: return VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
     }
 }
@@ -59,7 +61,7 @@ struct ComputeRenderer::Pipeline {
     vk::Buffer frameLow, rayStackLow;  // fp64 only
     std::uint32_t rayEntries = 1;     // the RAY_STACK and FRONTIER specialisations: an invocation's entries
     std::uint32_t maxMedia = 1;       // the MAX_MEDIA specialisation
-    std::uint32_t bindingCount = SNELL_BINDING_COUNT_FP32;
+    std::vector<std::uint32_t> bindings;  // the shader's, in order
     // What it was built for: kept between renders and reused while these match.
     Specialisation values{};
     // What its buffers hold: reused by renders that need no more (the preview
@@ -69,14 +71,26 @@ struct ComputeRenderer::Pipeline {
 };
 
 ComputeRenderer::ComputeRenderer(vk::Context& context, const Scene& scene, const Camera& camera,
-                                 gpu::Precision precision, gpu::BvhMode bvh)
+                                 gpu::Precision precision, gpu::BvhMode bvh, gpu::Traversal traversal)
     : context_(context), scene_(scene) {
     if (precision == gpu::Precision::Fp64 && !context.float64Supported())
         throw vk::VulkanError("--precision fp64 needs shader doubles (the shaderFloat64 feature), which " +
                               std::string(context.properties().deviceName) +
                               " lacks; use --precision fp32, or another device (--gpu; lavapipe has them)");
+    if (traversal == gpu::Traversal::RayQuery) {
+        if (precision == gpu::Precision::Fp64)
+            throw vk::VulkanError("--traversal ray-query traces in fp32: it cannot be combined with --precision fp64");
+        if (!context.rayQueriesEnabled())
+            throw vk::VulkanError("--traversal ray-query: " + context.rayQueryAbsence() + "; use --traversal bvh");
+        if (bvh == gpu::BvhMode::Auto) bvh = gpu::BvhMode::On;
+    }
+    // Auto takes the device's traversal on GPUs only: on lavapipe snell's walk
+    // measured faster (docs/performance.md, "The device's ray traversal").
+    const bool rayQuery = precision == gpu::Precision::Fp32 && context.rayQueriesEnabled() &&
+                          (traversal == gpu::Traversal::RayQuery ||
+                           (traversal == gpu::Traversal::Auto && !context.isCpuDevice()));
     const auto start = Clock::now();
-    layout_ = gpu::buildGpuScene(scene, camera, precision, bvh);
+    layout_ = gpu::buildGpuScene(scene, camera, precision, bvh, rayQuery);
     loopBudget_ = limitsLoopIterations(context) ? SNELL_LOOP_BUDGET_LIMITED : 0u;
     // Each scene array becomes a texel buffer (shared_layout.h): its structs
     // are runs of RGBA32 texels (R32 for a uint array).
@@ -103,6 +117,9 @@ ComputeRenderer::ComputeRenderer(vk::Context& context, const Scene& scene, const
         upload(SNELL_BINDING_MATERIALS, layout_.materials, rgba, "materials");
         upload(SNELL_BINDING_LIGHTS, layout_.lights, rgba, "lights");
         upload(SNELL_BINDING_BVH, layout_.nodes, VK_FORMAT_R32G32B32A32_UINT, "BVH nodes");
+        if (!layout_.sphereBoxes.empty())
+            sphereBoxes_ = std::make_unique<vk::BoxAccelerationStructure>(
+                context_, layout_.sphereBoxes.data(), static_cast<std::uint32_t>(layout_.sphereBoxes.size()));
         // Small scenes: the spheres again, as a uniform block (shared_layout.h);
         // for fp64 their low parts follow in the same buffer.
         std::vector<gpu::SphereBlock> blocks(2);
@@ -125,6 +142,10 @@ ComputeRenderer::ComputeRenderer(vk::Context& context, const Scene& scene, const
     uploadMs_ = msSince(start);
 }
 
+const char* ComputeRenderer::traversal() const {
+    return sphereBoxes_ ? "ray-query" : layout_.usesBvh() ? "bvh" : "loop";
+}
+
 bool ComputeRenderer::spheresInBlock() const {
     return !layout_.usesBvh() && layout_.spheres.size() <= SNELL_BLOCK_SPHERES;
 }
@@ -135,6 +156,7 @@ ComputeRenderer::~ComputeRenderer() {
 }
 
 void ComputeRenderer::destroyBuffers() {
+    sphereBoxes_.reset();
     for (VkBufferView& v : sceneViews_) {
         if (v) vkDestroyBufferView(context_.device(), v, nullptr);
         v = VK_NULL_HANDLE;
@@ -239,16 +261,19 @@ void ComputeRenderer::createPipeline(const Specialisation& values, Pipeline& p) 
     VkDevice device = context_.device();
     p.values = values;
     const bool wide = layout_.precision == gpu::Precision::Fp64;
-    p.bindingCount = wide ? SNELL_BINDING_COUNT : SNELL_BINDING_COUNT_FP32;
-    std::array<VkDescriptorSetLayoutBinding, SNELL_BINDING_COUNT> bindings{};
-    for (std::uint32_t i = 0; i < p.bindingCount; ++i) {
-        bindings[i].binding = i;
-        bindings[i].descriptorCount = 1;
-        bindings[i].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
-        bindings[i].descriptorType = descriptorType(i);
+    // The fp32 shader's bindings; fp64 adds the low parts, ray queries the acceleration structure.
+    p.bindings.clear();
+    for (std::uint32_t i = 0; i < (wide ? SNELL_BINDING_COUNT : SNELL_BINDING_COUNT_FP32); ++i) p.bindings.push_back(i);
+    if (sphereBoxes_) p.bindings.push_back(SNELL_BINDING_ACCELERATION);
+    std::vector<VkDescriptorSetLayoutBinding> bindings(p.bindings.size());
+    for (std::size_t k = 0; k < bindings.size(); ++k) {
+        bindings[k].binding = p.bindings[k];
+        bindings[k].descriptorCount = 1;
+        bindings[k].stageFlags = VK_SHADER_STAGE_COMPUTE_BIT;
+        bindings[k].descriptorType = descriptorType(p.bindings[k]);
     }
     VkDescriptorSetLayoutCreateInfo setInfo{VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO};
-    setInfo.bindingCount = p.bindingCount;
+    setInfo.bindingCount = static_cast<std::uint32_t>(bindings.size());
     setInfo.pBindings = bindings.data();
     check(vkCreateDescriptorSetLayout(device, &setInfo, nullptr, &p.setLayout), "vkCreateDescriptorSetLayout");
 
@@ -261,20 +286,23 @@ void ComputeRenderer::createPipeline(const Specialisation& values, Pipeline& p) 
     check(vkCreatePipelineLayout(device, &layoutInfo, nullptr, &p.layout), "vkCreatePipelineLayout");
 
     VkShaderModuleCreateInfo moduleInfo{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
-    moduleInfo.codeSize = wide ? sizeof(snell_trace_fp64_comp_spv) : sizeof(snell_trace_comp_spv);
-    moduleInfo.pCode = wide ? snell_trace_fp64_comp_spv : snell_trace_comp_spv;
+    moduleInfo.codeSize = wide ? sizeof(snell_trace_fp64_comp_spv)
+                          : sphereBoxes_ ? sizeof(snell_trace_ray_query_comp_spv)
+                                         : sizeof(snell_trace_comp_spv);
+    moduleInfo.pCode = wide ? snell_trace_fp64_comp_spv : sphereBoxes_ ? snell_trace_ray_query_comp_spv : snell_trace_comp_spv;
     check(vkCreateShaderModule(device, &moduleInfo, nullptr, &p.module), "vkCreateShaderModule");
 
     p.rayEntries = values[SNELL_SPEC_RAY_STACK] + values[SNELL_SPEC_FRONTIER];
     p.maxMedia = values[SNELL_SPEC_MAX_MEDIA];
     createComputePipeline(p);
 
-    std::array<VkDescriptorPoolSize, 3> sizes{{{VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 0},
-                                               {VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER, 0},
-                                               {VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 0}}};
-    for (std::uint32_t i = 0; i < p.bindingCount; ++i)
-        for (VkDescriptorPoolSize& size : sizes)
-            if (size.type == descriptorType(i)) ++size.descriptorCount;
+    std::vector<VkDescriptorPoolSize> sizes;
+    for (std::uint32_t binding : p.bindings) {
+        const VkDescriptorType type = descriptorType(binding);
+        auto size = std::find_if(sizes.begin(), sizes.end(), [&](const VkDescriptorPoolSize& s) { return s.type == type; });
+        if (size == sizes.end()) sizes.push_back({type, 1});
+        else ++size->descriptorCount;
+    }
     VkDescriptorPoolCreateInfo poolInfo{VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO};
     poolInfo.maxSets = 1;
     poolInfo.poolSizeCount = static_cast<std::uint32_t>(sizes.size());
@@ -452,8 +480,8 @@ void ComputeRenderer::ensureBuffers(Pipeline& p, const RenderRequest& request, c
         p.output = context_.createBuffer(p.tilePixels * sizeof(gpu::OutputPixel), kStorage, true);
     }
 
-    std::array<VkDescriptorBufferInfo, SNELL_BINDING_COUNT> bufferInfo{};
-    std::array<const vk::Buffer*, SNELL_BINDING_COUNT> buffers{};
+    std::array<VkDescriptorBufferInfo, SNELL_BINDING_ACCELERATION + 1> bufferInfo{};
+    std::array<const vk::Buffer*, SNELL_BINDING_ACCELERATION + 1> buffers{};
     buffers[SNELL_BINDING_OUTPUT] = &p.output;
     buffers[SNELL_BINDING_FRAME] = &p.frame;
     buffers[SNELL_BINDING_COUNTERS] = &p.counters;
@@ -462,22 +490,29 @@ void ComputeRenderer::ensureBuffers(Pipeline& p, const RenderRequest& request, c
     buffers[SNELL_BINDING_MEDIA_STACK] = &p.mediaStack;
     buffers[SNELL_BINDING_FRAME_LOW] = &p.frameLow;
     buffers[SNELL_BINDING_RAY_STACK_LOW] = &p.rayStackLow;
-    std::array<VkWriteDescriptorSet, SNELL_BINDING_COUNT> writes{};
-    for (std::uint32_t i = 0; i < p.bindingCount; ++i) {
-        writes[i] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
-        writes[i].dstSet = p.set;
-        writes[i].dstBinding = i;
-        writes[i].descriptorCount = 1;
-        writes[i].descriptorType = descriptorType(i);
-        if (writes[i].descriptorType == VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER) {
-            writes[i].pTexelBufferView = &sceneViews_[i];
+    VkWriteDescriptorSetAccelerationStructureKHR accelerationInfo{
+        VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET_ACCELERATION_STRUCTURE_KHR};
+    std::vector<VkWriteDescriptorSet> writes(p.bindings.size());
+    for (std::size_t k = 0; k < writes.size(); ++k) {
+        const std::uint32_t i = p.bindings[k];
+        writes[k] = {VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET};
+        writes[k].dstSet = p.set;
+        writes[k].dstBinding = i;
+        writes[k].descriptorCount = 1;
+        writes[k].descriptorType = descriptorType(i);
+        if (writes[k].descriptorType == VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER) {
+            writes[k].pTexelBufferView = &sceneViews_[i];
+        } else if (writes[k].descriptorType == VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR) {
+            accelerationInfo.accelerationStructureCount = 1;
+            accelerationInfo.pAccelerationStructures = &sphereBoxes_->top();
+            writes[k].pNext = &accelerationInfo;
         } else {
             if (!buffers[i]) buffers[i] = &sceneBuffers_[i];
             bufferInfo[i] = {buffers[i]->buffer, 0, VK_WHOLE_SIZE};
-            writes[i].pBufferInfo = &bufferInfo[i];
+            writes[k].pBufferInfo = &bufferInfo[i];
         }
     }
-    vkUpdateDescriptorSets(context_.device(), p.bindingCount, writes.data(), 0, nullptr);
+    vkUpdateDescriptorSets(context_.device(), static_cast<std::uint32_t>(writes.size()), writes.data(), 0, nullptr);
 }
 
 // Record one command buffer (`resumes`: after a barrier on the last

@@ -11,6 +11,7 @@
 #include "gpu/GpuScene.h"
 #include "image/Image.h"
 #include "render/RenderRequest.h"
+#include "vulkan/BoxAccelerationStructure.h"
 #include "vulkan/VulkanContext.h"
 
 namespace snell {
@@ -38,14 +39,21 @@ class ComputeRenderer {
 public:
     // Uploads the scene; `camera.eye` becomes the GPU's coordinate origin.
     // Fp64 needs the device's shaderFloat64 feature (else vk::VulkanError).
+    // Traversal::RayQuery needs ray queries enabled in the context and fp32
+    // (else vk::VulkanError), and searches every scene of two spheres or
+    // more through them; Auto uses them for BVH scenes on a GPU where enabled.
     ComputeRenderer(vk::Context& context, const Scene& scene, const Camera& camera,
-                    gpu::Precision precision = gpu::Precision::Fp32, gpu::BvhMode bvh = gpu::BvhMode::Auto);
+                    gpu::Precision precision = gpu::Precision::Fp32, gpu::BvhMode bvh = gpu::BvhMode::Auto,
+                    gpu::Traversal traversal = gpu::Traversal::Auto);
     ~ComputeRenderer();
     ComputeRenderer(const ComputeRenderer&) = delete;
     ComputeRenderer& operator=(const ComputeRenderer&) = delete;
 
     double uploadMs() const { return uploadMs_; }
     const gpu::GpuScene& layout() const { return layout_; }
+    // How the spheres are searched: "ray-query" (the device's traversal),
+    // "bvh" (snell's walk) or "loop" (every sphere, a small scene).
+    const char* traversal() const;
 
     // Render request.camera (any camera; coordinates stay relative to the
     // origin chosen for the construction camera). The pipeline and tile
@@ -101,6 +109,7 @@ private:
     std::uint32_t loopBudget_ = 0;  // where the driver ends long loops (gpu/DriverProbe.h), else 0
     bool countLanes_ = false;
     double uploadMs_ = 0.0;
+    std::unique_ptr<vk::BoxAccelerationStructure> sphereBoxes_;  // the ray-query traversal's, else null
     std::unique_ptr<Pipeline> cached_;  // the last render's, reused by the next when it fits
 };
 

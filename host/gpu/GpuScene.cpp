@@ -38,6 +38,24 @@ void outwardBox(const snell::Aabb& box, const snell::dvec3& eye, vec4& lower, ve
     lower.w = upper.w = 0.0f;
 }
 
+// A sphere's box for a ray-box test that the device does in float (a ray
+// query): rounded outwards, then padded by 2^-18 of its largest coordinate or
+// extent, far more than the few units in the last place a float slab test
+// can be off (Ize, "Robust BVH Ray Traversal", JCGT 2013), so a ray that
+// meets the sphere is never culled. A larger box only costs a sphere test.
+SphereBox paddedBox(const snell::Aabb& box, const snell::dvec3& origin) {
+    vec4 lower, upper;
+    outwardBox(box, origin, lower, upper);
+    SphereBox out;
+    for (int k = 0; k < 3; ++k) {
+        const float scale = std::max({std::abs(lower[k]), std::abs(upper[k]), upper[k] - lower[k]});
+        const float pad = scale * 0x1p-18f + std::numeric_limits<float>::min();
+        out.lower[k] = lower[k] - pad;
+        out.upper[k] = upper[k] + pad;
+    }
+    return out;
+}
+
 }  // namespace
 
 void splitDouble(double v, float& hi, float& lo) {
@@ -112,7 +130,8 @@ std::vector<std::uint32_t> layOutBvh(const snell::Scene& scene, const snell::dve
 
 }  // namespace
 
-GpuScene buildGpuScene(const snell::Scene& scene, const snell::Camera& camera, Precision precision, BvhMode bvh) {
+GpuScene buildGpuScene(const snell::Scene& scene, const snell::Camera& camera, Precision precision, BvhMode bvh,
+                       bool sphereBoxes) {
     GpuScene out;
     out.precision = precision;
     const bool wide = precision == Precision::Fp64;
@@ -131,6 +150,10 @@ GpuScene buildGpuScene(const snell::Scene& scene, const snell::Camera& camera, P
                         : bvh == BvhMode::Off ? false
                                               : scene.spheres.size() > kBvhThreshold;
     if (useBvh) order = layOutBvh(scene, eye, out);
+    if (useBvh && sphereBoxes) {
+        out.sphereBoxes.reserve(order.size());
+        for (std::uint32_t index : order) out.sphereBoxes.push_back(paddedBox(snell::sphereBounds(scene.spheres[index]), eye));
+    }
 
     out.spheres.reserve(scene.spheres.size());
     out.sphereMaterials.reserve(scene.spheres.size());
@@ -230,7 +253,7 @@ FrameParams makeFrameParams(const snell::Scene& scene, const GpuScene& gpuScene,
 std::size_t GpuScene::bytes() const {
     std::size_t total = 0;
     auto add = [&](const auto& v) { total += v.size() * sizeof(v[0]); };
-    add(spheres), add(sphereMaterials), add(ellipsoids), add(materials), add(lights), add(nodes);
+    add(spheres), add(sphereMaterials), add(ellipsoids), add(materials), add(lights), add(nodes), add(sphereBoxes);
     add(sphereLows), add(ellipsoidLows), add(lightLows);
     return total;
 }

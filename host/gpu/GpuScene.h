@@ -46,6 +46,15 @@ enum class Precision { Fp32, Fp64 };
 inline constexpr std::size_t kBvhThreshold = SNELL_MAX_UNROLLED_SPHERES;
 // Whether to build and traverse a BVH: by that threshold, or forced (the bench).
 enum class BvhMode { Auto, Off, On };
+// How a BVH scene is searched: snell's own walk (trace.comp, traverseBvh), or
+// the device's ray traversal (VK_KHR_ray_query over the spheres' boxes), or
+// the device's where it is enabled (vk::ContextOptions::rayQueries).
+enum class Traversal { Auto, Walk, RayQuery };
+
+// A sphere's box as VkAabbPositionsKHR lays it out (6 floats).
+struct SphereBox {
+    float lower[3], upper[3];
+};
 
 struct GpuScene {
     std::vector<Sphere> spheres;
@@ -54,6 +63,9 @@ struct GpuScene {
     std::vector<Material> materials;
     std::vector<Light> lights;
     std::vector<BvhNode> nodes;  // empty when no BVH is used
+    // With sphereBoxes asked for and a BVH: each sphere's box, in sphere
+    // order, rounded outwards and padded for a float ray-box test.
+    std::vector<SphereBox> sphereBoxes;
     // Fp64 only (else empty): the low parts of the float pairs hi + lo, in
     // the same layout (shared_layout.h); their non-geometric members are 0.
     std::vector<Sphere> sphereLows;
@@ -75,7 +87,7 @@ struct GpuScene {
 };
 
 GpuScene buildGpuScene(const snell::Scene& scene, const snell::Camera& camera,
-                       Precision precision = Precision::Fp32, BvhMode bvh = BvhMode::Auto);
+                       Precision precision = Precision::Fp32, BvhMode bvh = BvhMode::Auto, bool sphereBoxes = false);
 
 // How far primary rays from `eye` can go before they could meet any sphere.
 double primaryStartDistance(const snell::Scene& scene, const snell::dvec3& eye);

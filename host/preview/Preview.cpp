@@ -178,7 +178,8 @@ void Session::loadScene(std::unique_ptr<Scene> scene) {
     const bool keepCamera = scene_ && !camera_.atHome();
     size_ = o_.size.value_or(scene->imageSize);
     const Camera home = Camera::fromSpec(size_, scene->halfWidth);
-    auto renderer = std::make_unique<ComputeRenderer>(*context_, *scene, home, o_.precision);
+    auto renderer = std::make_unique<ComputeRenderer>(*context_, *scene, home, o_.precision, gpu::BvhMode::Auto,
+                                                      o_.traversal);
     renderer_ = std::move(renderer);  // the old renderer goes before its scene
     scene_ = std::move(scene);
     if (!keepCamera) camera_ = OrbitCamera(*scene_, home, scene_->halfWidth);
@@ -327,6 +328,7 @@ vk::ContextOptions Session::contextOptions() const {
     options.deviceIndex = o_.gpu;
     options.validation = o_.validation;
     options.pipelineCachePath = o_.pipelineCachePath;
+    options.rayQueries = o_.rayQueries;
     for (std::uint32_t i = 0; i < count; ++i) options.instanceExtensions.push_back(required[i]);
     options.deviceExtensions.push_back(VK_KHR_SWAPCHAIN_EXTENSION_NAME);
     return options;

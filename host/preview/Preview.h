@@ -11,6 +11,7 @@
 #include <string>
 
 #include "gpu/GpuScene.h"
+#include "vulkan/VulkanContext.h"
 
 namespace snell {
 
@@ -26,6 +27,8 @@ struct PreviewOptions {
     int gpu = -1;
     bool validation = false;
     gpu::Precision precision = gpu::Precision::Fp32;
+    gpu::Traversal traversal = gpu::Traversal::Auto;
+    vk::RayQueries rayQueries = vk::RayQueries::OnGpus;  // what the traversal needs enabled
     bool quiet = false;
     // Scripted mode: after `frames` frames (> 0), save `screenshot` (when set)
     // and return. `orbitDegrees` orbits the camera before the first frame;

@@ -51,6 +51,41 @@ bool hasLayer(const char* name) {
 }
 
 // Check a physical device for what snell needs; fills `family` and a report.
+// The device extensions of the ray-query traversal.
+constexpr const char* kRayQueryExtensions[] = {VK_KHR_ACCELERATION_STRUCTURE_EXTENSION_NAME,
+                                               VK_KHR_RAY_QUERY_EXTENSION_NAME,
+                                               VK_KHR_DEFERRED_HOST_OPERATIONS_EXTENSION_NAME};
+
+bool hasExtension(const std::vector<VkExtensionProperties>& available, const std::string& name) {
+    return std::any_of(available.begin(), available.end(),
+                       [&](const VkExtensionProperties& p) { return name == p.extensionName; });
+}
+
+// Whether the device can trace through ray queries (its extensions and the
+// features they need); if not, why not.
+bool supportsRayQueries(VkPhysicalDevice device, std::string& why) {
+    std::uint32_t count = 0;
+    vkEnumerateDeviceExtensionProperties(device, nullptr, &count, nullptr);
+    std::vector<VkExtensionProperties> available(count);
+    vkEnumerateDeviceExtensionProperties(device, nullptr, &count, available.data());
+    for (const char* e : kRayQueryExtensions)
+        if (!hasExtension(available, e)) {
+            why = std::string("the device lacks ") + e;
+            return false;
+        }
+    VkPhysicalDeviceRayQueryFeaturesKHR rayQuery{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_QUERY_FEATURES_KHR};
+    VkPhysicalDeviceAccelerationStructureFeaturesKHR accel{
+        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR, &rayQuery};
+    VkPhysicalDeviceVulkan12Features v12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES, &accel};
+    VkPhysicalDeviceFeatures2 features{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &v12};
+    vkGetPhysicalDeviceFeatures2(device, &features);
+    if (!rayQuery.rayQuery || !accel.accelerationStructure || !v12.bufferDeviceAddress) {
+        why = "the device lacks the rayQuery, accelerationStructure or bufferDeviceAddress feature";
+        return false;
+    }
+    return true;
+}
+
 DeviceReport examine(VkPhysicalDevice device, int index, std::uint32_t& family,
                      const std::vector<std::string>& extensions) {
     DeviceReport report;
@@ -84,8 +119,7 @@ DeviceReport examine(VkPhysicalDevice device, int index, std::uint32_t& family,
     std::vector<VkExtensionProperties> available(extCount);
     vkEnumerateDeviceExtensionProperties(device, nullptr, &extCount, available.data());
     for (const std::string& e : extensions) {
-        if (std::none_of(available.begin(), available.end(),
-                         [&](const VkExtensionProperties& p) { return e == p.extensionName; })) {
+        if (!hasExtension(available, e)) {
             report.reason = "lacks the device extension " + e;
             return report;
         }
@@ -106,6 +140,8 @@ DeviceReport examine(VkPhysicalDevice device, int index, std::uint32_t& family,
         return report;
     }
     report.usable = true;
+    std::string ignored;
+    report.rayQueries = supportsRayQueries(device, ignored);
     return report;
 }
 
@@ -282,7 +318,7 @@ Context::Context(const ContextOptions& options) : fault_(options.fault) {
         vkGetPhysicalDeviceQueueFamilyProperties(physical_, &count, qf.data());
         timestampValidBits_ = qf[queueFamily_].timestampValidBits;
 
-        createDevice(options.deviceExtensions);
+        createDevice(options.deviceExtensions, options.rayQueries);
         openPipelineCache(options.pipelineCachePath);
     } catch (...) {
         release();
@@ -334,13 +370,29 @@ int Context::chooseDevice(const std::vector<VkPhysicalDevice>& devices, const Co
 }
 
 // The logical device with one compute queue, shader doubles where the device
-// has them, and the one-off command pool and fence.
-void Context::createDevice(const std::vector<std::string>& extensions) {
+// has them, ray queries where asked for and the device has them, and the
+// one-off command pool and fence.
+void Context::createDevice(const std::vector<std::string>& extensions, RayQueries rayQueries) {
     VkPhysicalDeviceFeatures supported;
     vkGetPhysicalDeviceFeatures(physical_, &supported);
-    VkPhysicalDeviceFeatures enabled{};
+    VkPhysicalDeviceFeatures2 enabled{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
     float64_ = supported.shaderFloat64;
-    enabled.shaderFloat64 = supported.shaderFloat64;
+    enabled.features.shaderFloat64 = supported.shaderFloat64;
+    VkPhysicalDeviceRayQueryFeaturesKHR rayQuery{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_QUERY_FEATURES_KHR};
+    VkPhysicalDeviceAccelerationStructureFeaturesKHR accel{
+        VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR, &rayQuery};
+    VkPhysicalDeviceVulkan12Features v12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES, &accel};
+    if (rayQueries == RayQueries::Off) {
+        rayQueryAbsence_ = "ray queries were not asked for";
+    } else if (rayQueries == RayQueries::OnGpus && isCpuDevice()) {
+        rayQueryAbsence_ = "not enabled on a CPU device, where snell's BVH walk is faster";
+    } else if (supportsRayQueries(physical_, rayQueryAbsence_)) {
+        rayQueries_ = true;
+        rayQuery.rayQuery = VK_TRUE;
+        accel.accelerationStructure = VK_TRUE;
+        v12.bufferDeviceAddress = VK_TRUE;
+        enabled.pNext = &v12;
+    }
     const float priority = 1.0f;
     VkDeviceQueueCreateInfo queueInfo{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
     queueInfo.queueFamilyIndex = queueFamily_;
@@ -348,10 +400,11 @@ void Context::createDevice(const std::vector<std::string>& extensions) {
     queueInfo.pQueuePriorities = &priority;
     std::vector<const char*> exts;
     for (const std::string& e : extensions) exts.push_back(e.c_str());
-    VkDeviceCreateInfo info{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
+    if (rayQueries_)
+        for (const char* e : kRayQueryExtensions) exts.push_back(e);
+    VkDeviceCreateInfo info{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO, &enabled};
     info.queueCreateInfoCount = 1;
     info.pQueueCreateInfos = &queueInfo;
-    info.pEnabledFeatures = &enabled;
     info.enabledExtensionCount = static_cast<std::uint32_t>(exts.size());
     info.ppEnabledExtensionNames = exts.data();
     check(vkCreateDevice(physical_, &info, nullptr, &device_), "vkCreateDevice");
@@ -465,7 +518,10 @@ Buffer Context::createBuffer(VkDeviceSize size, VkBufferUsageFlags usage, bool h
     check(vkCreateBuffer(device_, &info, nullptr, &b.buffer), "vkCreateBuffer");
     VkMemoryRequirements req;
     vkGetBufferMemoryRequirements(device_, b.buffer, &req);
+    VkMemoryAllocateFlagsInfo flags{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_FLAGS_INFO};
+    flags.flags = VK_MEMORY_ALLOCATE_DEVICE_ADDRESS_BIT;
     VkMemoryAllocateInfo alloc{VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO};
+    if (usage & VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT) alloc.pNext = &flags;
     alloc.allocationSize = req.size;
     try {
         alloc.memoryTypeIndex = hostVisible
@@ -518,6 +574,12 @@ Buffer Context::createBufferWithData(const void* bytes, VkDeviceSize size, VkBuf
     }
     destroy(staging);
     return target;
+}
+
+VkDeviceAddress Context::deviceAddress(const Buffer& b) const {
+    VkBufferDeviceAddressInfo info{VK_STRUCTURE_TYPE_BUFFER_DEVICE_ADDRESS_INFO};
+    info.buffer = b.buffer;
+    return vkGetBufferDeviceAddress(device_, &info);
 }
 
 void Context::destroy(Buffer& b) {

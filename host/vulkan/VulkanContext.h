@@ -51,6 +51,12 @@ void imageBarrier(VkCommandBuffer cmd, VkImage image, VkImageLayout from, VkImag
 // "device-lost[:N]" or "out-of-device-memory[:N]"; throws std::invalid_argument.
 FaultInjection parseFaultInjection(const std::string& text);
 
+// Whether the device's own ray traversal (VK_KHR_ray_query over
+// VK_KHR_acceleration_structure, with buffer device addresses) is enabled
+// where the device has it: never, on GPUs only (the default: on lavapipe,
+// snell's BVH walk measured faster; docs/performance.md), or on any device.
+enum class RayQueries { Off, OnGpus, On };
+
 struct ContextOptions {
     int deviceIndex = -1;         // -1: choose (discrete GPU first); else this index
     bool validation = false;      // enable VK_LAYER_KHRONOS_validation
@@ -60,6 +66,7 @@ struct ContextOptions {
     // Where compiled pipelines are kept between runs (read at start, written
     // back at the end); empty: no cache on disk.
     std::string pipelineCachePath;
+    RayQueries rayQueries = RayQueries::OnGpus;
 };
 
 struct DeviceReport {
@@ -69,6 +76,7 @@ struct DeviceReport {
     std::string driver;
     bool usable = false;
     std::string reason;  // why it was passed over, when it was
+    bool rayQueries = false;  // has ray queries and acceleration structures
 };
 
 struct Buffer {
@@ -103,6 +111,11 @@ public:
     const std::string& driverInfo() const { return driverInfo_; }
     bool timestampsSupported() const { return timestampValidBits_ > 0 && properties_.limits.timestampComputeAndGraphics; }
     bool float64Supported() const { return float64_; }
+    // The device's ray traversal is enabled (ContextOptions::rayQueries); if
+    // not, rayQueryAbsence() says why, for a message.
+    bool rayQueriesEnabled() const { return rayQueries_; }
+    const std::string& rayQueryAbsence() const { return rayQueryAbsence_; }
+    bool isCpuDevice() const { return properties_.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU; }
     // Mesa's llvmpipe (lavapipe): its shaders end all loops after 65535
     // iterations per SIMD row and dispatch, which the renderer works around.
     bool isLlvmpipe() const { return driverId_ == VK_DRIVER_ID_MESA_LLVMPIPE; }
@@ -110,12 +123,15 @@ public:
     std::uint32_t validationMessages() const { return validationMessages_; }
     const std::vector<DeviceReport>& deviceReports() const { return reports_; }
 
-    // Device-local when possible; host-visible (and mapped) when asked.
+    // Device-local when possible; host-visible (and mapped) when asked. A
+    // usage with VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT gets memory that
+    // has one (deviceAddress).
     Buffer createBuffer(VkDeviceSize size, VkBufferUsageFlags usage, bool hostVisible);
     // A device-local buffer holding `bytes` (staged through a host buffer when
     // device-local memory is not host-visible).
     Buffer createBufferWithData(const void* bytes, VkDeviceSize size, VkBufferUsageFlags usage);
     void destroy(Buffer& buffer);
+    VkDeviceAddress deviceAddress(const Buffer& buffer) const;
     StorageImage createStorageImage(std::uint32_t width, std::uint32_t height, VkFormat format);
     // A device-local 2D image with a view, for any usage.
     StorageImage createImage(std::uint32_t width, std::uint32_t height, VkFormat format, VkImageUsageFlags usage);
@@ -141,7 +157,7 @@ public:
 private:
     int chooseDevice(const std::vector<VkPhysicalDevice>& devices, const ContextOptions& options,
                      std::uint32_t& family);
-    void createDevice(const std::vector<std::string>& extensions);
+    void createDevice(const std::vector<std::string>& extensions, RayQueries rayQueries);
     void openPipelineCache(const std::string& path);
     std::uint32_t findMemoryType(std::uint32_t typeBits, VkMemoryPropertyFlags required,
                                  VkMemoryPropertyFlags preferred) const;
@@ -164,6 +180,8 @@ private:
     std::uint32_t queueFamily_ = 0;
     std::uint32_t timestampValidBits_ = 0;
     bool float64_ = false;
+    bool rayQueries_ = false;
+    std::string rayQueryAbsence_;
     VkDriverId driverId_{};
     VkPhysicalDeviceProperties properties_{};
     VkPhysicalDeviceMemoryProperties memory_{};
