@@ -104,7 +104,10 @@ using uint = std::uint32_t;
 #define SNELL_COUNTER_TRACE_BUSY 10
 #define SNELL_COUNTER_WALK_SLOTS 11
 #define SNELL_COUNTER_WALK_BUSY 12
-#define SNELL_COUNTER_COUNT 13
+// Pixels of the tile taken after the first one of each invocation (trace.comp,
+// takePixel); kept across the dispatches that resume a tile.
+#define SNELL_COUNTER_NEXT_PIXEL 13
+#define SNELL_COUNTER_COUNT 14
 
 // Mesa's llvmpipe before 24 (lavapipe in Debian 12's Mesa 22.3) ends every
 // loop of a shader once one SIMD row has run 65535 loop iterations in total in
@@ -265,18 +268,16 @@ struct FrameParams {
 };
 
 // Push constants: the tile of the image this dispatch covers, and whether it
-// resumes the invocations' suspended work (SlotState) or starts afresh. An
-// invocation steps through the tile's pixels (row-major) by the number of
-// invocations, which is stepY rows and stepX columns (no division per pixel).
+// resumes the invocations' suspended work (SlotState) or starts afresh.
 struct TileParams {
     uint originX;
     uint originY;
     uint width;
     uint height;
     uint resume;
-    uint stepX;
-    uint stepY;
     uint pad0;
+    uint pad1;
+    uint pad2;
 };
 
 #ifdef __cplusplus

@@ -6,11 +6,11 @@
 // host/reference/CpuRenderer.cpp; the intersection maths is explained in
 // host/reference/Intersect.h.
 //
-// Invocations are persistent: invocation k of K renders pixels k, k + K,
-// k + 2K, ... of the tile, one ray at a time, taking its next pixel as soon as
-// the last one is finished. So a SIMD row stays full while its pixels' ray
-// trees differ in size, and an invocation's ray stack (device memory) is
-// reused from pixel to pixel instead of being one per pixel.
+// Invocations are persistent: invocation k of K starts on pixel k of the tile
+// and then takes the next pixel no invocation has taken (takePixel), one ray
+// at a time, as soon as its last one is finished. So a SIMD row stays full
+// while its pixels' ray trees differ in size, and an invocation's ray stack
+// (device memory) is reused from pixel to pixel instead of being one per pixel.
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #extension GL_KHR_shader_subgroup_basic : require
@@ -769,6 +769,13 @@ void beginStep(inout SlotState state) {
     state.frontierOld = state.frontierCount;
 }
 
+// The invocation's next pixel of the tile. Each invocation starts on its own
+// (pixel = slot); after that, one that finishes a pixel takes the next not
+// yet taken, so while pixels remain no lane idles beside a lane whose pixel
+// is expensive (a fixed share of the tile each left most lanes of a subgroup
+// waiting on the one with the deep glass tree or the long BVH walks).
+uint takePixel() { return invocations + atomicAdd(counters[SNELL_COUNTER_NEXT_PIXEL], 1u); }
+
 // The finished pixel written out (render/Truncation.h: its colour, bound and
 // how it stopped), and the invocation moved on to its next pixel.
 void finishPixel(uint slot, inout SlotState state, StepOutcome o, uint shadowRays) {
@@ -778,7 +785,7 @@ void finishPixel(uint slot, inout SlotState state, StepOutcome o, uint shadowRay
         vec4(o.settled ? o.estimate : -1.0, float(state.overBudget), overTolerance ? 1.0 : 0.0, 0.0));
     uint finished = state.finished + 1u;
     uint rays = state.rays;
-    state = freshPixel(state.pixel + invocations);
+    state = freshPixel(takePixel());
     state.finished = finished;
     state.rays = rays;
     slotStates[slot].finished = finished;
@@ -797,8 +804,7 @@ bool endStep(uint slot, inout SlotState state, inout uvec2 pixel, inout float cu
         return false;
     }
     finishPixel(slot, state, outcome, shadowRays);
-    pixel += uvec2(tile.stepX, tile.stepY);
-    if (pixel.x >= tile.width) pixel += uvec2(-tile.width, 1u);
+    pixel = uvec2(state.pixel % tile.width, state.pixel / tile.width);
     cutOff = firstCutOff;
     return state.pixel >= tilePixels;
 }

@@ -103,8 +103,6 @@ TEST(Layout, TileParams) {
     EXPECT_EQ(offsetof(gpu::TileParams, width), 8u);
     EXPECT_EQ(offsetof(gpu::TileParams, height), 12u);
     EXPECT_EQ(offsetof(gpu::TileParams, resume), 16u);
-    EXPECT_EQ(offsetof(gpu::TileParams, stepX), 20u);
-    EXPECT_EQ(offsetof(gpu::TileParams, stepY), 24u);
 }
 
 TEST(Layout, SlotStateAndPendingRay) {

@@ -397,8 +397,6 @@ struct ComputeRenderer::TilePlan {
         t.originY = std::uint32_t(area.y0 + ty * tileHeight);
         t.width = std::uint32_t(std::min(tileWidth, area.width() - tx * tileWidth));
         t.height = std::uint32_t(std::min(tileHeight, area.height() - ty * tileHeight));
-        t.stepX = std::uint32_t(invocations % t.width);
-        t.stepY = std::uint32_t(invocations / t.width);
         return t;
     }
 };
@@ -607,7 +605,10 @@ void ComputeRenderer::dispatchTile(Pipeline& p, const RenderRequest& request, co
     };
     for (int pass = 0;; ++pass) {
         if (request.cancel && request.cancel->load()) throw vk::VulkanError("render cancelled");
+        // A resumed dispatch goes on taking the tile's pixels where the last one stopped.
+        const std::uint32_t pixelsTaken = pass > 0 ? counters[SNELL_COUNTER_NEXT_PIXEL] : 0u;
         std::memset(counters, 0, SNELL_COUNTER_COUNT * sizeof(std::uint32_t));
+        counters[SNELL_COUNTER_NEXT_PIXEL] = pixelsTaken;
         tile.resume = pass > 0 ? 1u : 0u;
         if (pass == 0) std::memset(p.slotStates.mapped, 0, plan.invocations * sizeof(gpu::SlotState));
         submit(p, progress, true, pass > 0, [&](VkCommandBuffer cmd) {
