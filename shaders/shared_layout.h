@@ -104,10 +104,12 @@ using uint = std::uint32_t;
 #define SNELL_COUNTER_TRACE_BUSY 10
 #define SNELL_COUNTER_WALK_SLOTS 11
 #define SNELL_COUNTER_WALK_BUSY 12
-// Pixels of the tile taken after the first one of each invocation (trace.comp,
-// takePixel); kept across the dispatches that resume a tile.
-#define SNELL_COUNTER_NEXT_PIXEL 13
-#define SNELL_COUNTER_COUNT 14
+#define SNELL_COUNTER_COUNT 13
+// After them, for workgroup w at SNELL_COUNTER_COUNT + w · SNELL_COUNTER_STRIDE
+// (a cache line each), the pixels of its share of the tile its invocations
+// have taken after their first (trace.comp, takePixel); kept across the
+// dispatches that resume a tile.
+#define SNELL_COUNTER_STRIDE 16
 
 // Mesa's llvmpipe before 24 (lavapipe in Debian 12's Mesa 22.3) ends every
 // loop of a shader once one SIMD row has run 65535 loop iterations in total in

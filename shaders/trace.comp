@@ -7,7 +7,7 @@
 // host/reference/Intersect.h.
 //
 // Invocations are persistent: invocation k of K starts on pixel k of the tile
-// and then takes the next pixel no invocation has taken (takePixel), one ray
+// and then takes the next pixel its workgroup has not taken (takePixel), one ray
 // at a time, as soon as its last one is finished. So a SIMD row stays full
 // while its pixels' ray trees differ in size, and an invocation's ray stack
 // (device memory) is reused from pixel to pixel instead of being one per pixel.
@@ -769,12 +769,21 @@ void beginStep(inout SlotState state) {
     state.frontierOld = state.frontierCount;
 }
 
-// The invocation's next pixel of the tile. Each invocation starts on its own
-// (pixel = slot); after that, one that finishes a pixel takes the next not
-// yet taken, so while pixels remain no lane idles beside a lane whose pixel
-// is expensive (a fixed share of the tile each left most lanes of a subgroup
-// waiting on the one with the deep glass tree or the long BVH walks).
-uint takePixel() { return invocations + atomicAdd(counters[SNELL_COUNTER_NEXT_PIXEL], 1u); }
+// The invocation's next pixel of the tile. The tile is dealt to the
+// workgroups in runs of a workgroup's size (run r to workgroup r mod W); each
+// invocation starts on its own pixel of its workgroup's first run (pixel =
+// slot), and one that finishes a pixel takes its workgroup's next pixel not
+// yet taken, so while the workgroup has pixels left no lane idles beside a
+// lane whose pixel is expensive (a fixed share each left most lanes of a
+// subgroup waiting on the one with the deep glass tree or the long BVH
+// walks). A counter per workgroup, on a cache line of its own: one counter
+// for the whole tile moved between the cores at every pixel, which cost
+// more than it won on cheap scenes (bench/simple, 2 threads).
+uint takePixel() {
+    const uint size = uint(SNELL_WORKGROUP_SIZE);
+    uint taken = size + atomicAdd(counters[SNELL_COUNTER_COUNT + gl_WorkGroupID.x * SNELL_COUNTER_STRIDE], 1u);
+    return taken / size * invocations + gl_WorkGroupID.x * size + taken % size;
+}
 
 // The finished pixel written out (render/Truncation.h: its colour, bound and
 // how it stopped), and the invocation moved on to its next pixel.

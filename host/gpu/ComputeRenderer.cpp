@@ -364,6 +364,11 @@ void memoryBarrier(VkCommandBuffer cmd, VkAccessFlags srcAccess, VkAccessFlags d
     vkCmdPipelineBarrier(cmd, srcStage, dstStage, 0, 1, &b, 0, nullptr, 0, nullptr);
 }
 
+// The dispatch's counters and then each workgroup's (shared_layout.h).
+std::size_t counterCount(std::uint64_t workgroups) {
+    return SNELL_COUNTER_COUNT + workgroups * SNELL_COUNTER_STRIDE;
+}
+
 // Device memory for the invocations' ray stacks.
 constexpr VkDeviceSize kStackBudget = 64ull << 20;
 // Workgroups of persistent invocations per core on a CPU device (lavapipe):
@@ -448,7 +453,6 @@ ComputeRenderer::Pipeline& ComputeRenderer::ensurePipeline(const Specialisation&
     if (cached_) destroyPipeline(*cached_);
     cached_ = std::make_unique<Pipeline>();
     createPipeline(values, *cached_);
-    cached_->counters = context_.createBuffer(SNELL_COUNTER_COUNT * sizeof(std::uint32_t), kStorage, true);
     return *cached_;
 }
 
@@ -461,9 +465,12 @@ void ComputeRenderer::ensureBuffers(Pipeline& p, const RenderRequest& request, c
     p.frame = context_.createBufferWithData(&frame, sizeof frame, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
     if (wide) p.frameLow = context_.createBufferWithData(&frameLow, sizeof frameLow, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
     if (plan.invocations > p.slots) {
-        for (vk::Buffer* b : {&p.slotStates, &p.rayStack, &p.mediaStack, &p.rayStackLow}) context_.destroy(*b);
+        for (vk::Buffer* b : {&p.counters, &p.slotStates, &p.rayStack, &p.mediaStack, &p.rayStackLow})
+            context_.destroy(*b);
         const VkDeviceSize slots = plan.invocations;
         p.slots = slots;
+        p.counters = context_.createBuffer(counterCount(slots / SNELL_WORKGROUP_SIZE) * sizeof(std::uint32_t),
+                                           kStorage, true);
         // Host-visible: the host reads the invocations' progress while they run.
         p.slotStates = context_.createBuffer(slots * sizeof(gpu::SlotState), kStorage, true);
         p.rayStack = context_.createBuffer(slots * p.rayEntries * sizeof(gpu::PendingRay), kStorage, false);
@@ -605,10 +612,8 @@ void ComputeRenderer::dispatchTile(Pipeline& p, const RenderRequest& request, co
     };
     for (int pass = 0;; ++pass) {
         if (request.cancel && request.cancel->load()) throw vk::VulkanError("render cancelled");
-        // A resumed dispatch goes on taking the tile's pixels where the last one stopped.
-        const std::uint32_t pixelsTaken = pass > 0 ? counters[SNELL_COUNTER_NEXT_PIXEL] : 0u;
-        std::memset(counters, 0, SNELL_COUNTER_COUNT * sizeof(std::uint32_t));
-        counters[SNELL_COUNTER_NEXT_PIXEL] = pixelsTaken;
+        // A resumed dispatch goes on taking the workgroups' pixels where the last one stopped.
+        std::memset(counters, 0, (pass > 0 ? SNELL_COUNTER_COUNT : counterCount(groups)) * sizeof(std::uint32_t));
         tile.resume = pass > 0 ? 1u : 0u;
         if (pass == 0) std::memset(p.slotStates.mapped, 0, plan.invocations * sizeof(gpu::SlotState));
         submit(p, progress, true, pass > 0, [&](VkCommandBuffer cmd) {
