@@ -73,6 +73,15 @@ head -c 2 "$work/basic.pfm" | grep -q PF && ok || bad "PFM magic"
 # EXR: written, read back by compare, equal to the PFM of the same render.
 "$SNELL" render "$SCENES/basic.scn" --size 32 -o "$work/basic.exr" -q && "$SNELL" compare --json "$work/basic.exr" "$work/basic.pfm" |
   grep -q '"max_error": 0' && ok || bad "EXR output"
+# Every EXR compression is lossless, and a compression snell does not know is a usage error.
+for c in piz rle zip none; do
+  "$SNELL" render "$SCENES/showcase.scn" --size 48 -q --exr-compression $c -o "$work/c-$c.exr" &&
+    "$SNELL" render "$SCENES/showcase.scn" --size 48 -q -o "$work/c-ref.pfm" &&
+    "$SNELL" compare --json "$work/c-$c.exr" "$work/c-ref.pfm" | grep -q '"max_error": 0' && ok ||
+    bad "EXR with --exr-compression $c is not the PFM's image"
+done
+"$SNELL" render "$SCENES/basic.scn" --size 8 --exr-compression lzma -o "$work/c.exr" 2>"$work/err"; status=$?
+[ $status -eq 2 ] && grep -q "piz" "$work/err" && [ ! -e "$work/c.exr" ] && ok || bad "unknown EXR compression ($status)"
 
 # Ctrl-C, SIGTERM or SIGHUP during a long render (CPU and GPU): status 128 +
 # the signal, no output file, no temporary left.

@@ -63,6 +63,7 @@ public:
         c->add_option("-s,--size", size_,
                       "The whole image's size, so a missing piece is an error (default: the extent of the pieces)")
             ->check(CLI::Range(1, ParseLimits::kMaxImageSize));
+        addEncodingOptions(*c, encoding_);
         return c;
     }
 
@@ -87,7 +88,8 @@ public:
             width = height = size_;
         }
         const Image whole = join(pieces, width, height);
-        writeImage(output_, whole, {{"Software", std::string("snell ") + SNELL_VERSION + " assemble"}});
+        writeImage(output_, whole, {{"Software", std::string("snell ") + SNELL_VERSION + " assemble"}}, {},
+                   encoding_.exr());
         return kExitSuccess;
     }
 
@@ -111,6 +113,7 @@ private:
     std::string output_;
     std::vector<std::string> pieces_;
     int size_ = 0;
+    EncodingOptions encoding_;
 };
 
 }  // namespace

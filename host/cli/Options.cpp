@@ -30,6 +30,13 @@ const CLI::Validator kFinite(
     },
     "FINITE");
 
+void addEncodingOptions(CLI::App& command, EncodingOptions& o) {
+    command.add_option("--exr-compression", o.exrCompression,
+                       "How an .exr output is compressed, all lossless: piz (default), rle (faster on flat "
+                       "images, useless on detailed ones), zip (slower), none (largest)")
+        ->check(CLI::IsMember({"piz", "rle", "zip", "none"}));
+}
+
 void addDeviceOptions(CLI::App& command, DeviceOptions& o) {
     command.add_option("--gpu", o.gpu, "Vulkan device index (see 'snell devices'; default: $SNELL_GPU, else the best)")
         ->envname("SNELL_GPU")->check(CLI::NonNegativeNumber);

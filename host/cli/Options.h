@@ -7,6 +7,7 @@
 #include <CLI/CLI.hpp>
 
 #include "gpu/GpuScene.h"
+#include "image/ImageIO.h"
 #include "scene/Scene.h"
 #include "vulkan/VulkanContext.h"
 
@@ -16,6 +17,13 @@ namespace snell::cli {
 extern const CLI::Validator kImageFormat;
 // CLI11's Range lets NaN through (every comparison with it is false).
 extern const CLI::Validator kFinite;
+
+// --exr-compression: how an EXR output is compressed (lossless; see ExrCompression).
+struct EncodingOptions {
+    std::string exrCompression = exrCompressionName(kDefaultExrCompression);
+    ExrCompression exr() const { return exrCompressionNamed(exrCompression); }
+};
+void addEncodingOptions(CLI::App& command, EncodingOptions& options);
 
 // Which Vulkan device renders, and how: --gpu, --precision, --traversal, --validation.
 struct DeviceOptions {

@@ -1,6 +1,7 @@
 #include "cli/Progress.h"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 #include <unistd.h>
@@ -41,31 +42,61 @@ void Progress::show(double fraction, std::uint64_t rays) {
     std::fflush(stderr);
 }
 
-void Progress::expectCost(std::vector<double> regions) {
+void Progress::expectCost(const std::vector<double>& seconds, const std::vector<double>& rays) {
     std::lock_guard<std::mutex> lock(mutex_);
-    cumulativeCost_.assign(1, 0.0);
-    for (double c : regions) cumulativeCost_.push_back(cumulativeCost_.back() + c);
-    if (cumulativeCost_.back() <= 0.0) cumulativeCost_.clear();
+    for (auto [model, costs] : {std::pair{&time_, &seconds}, std::pair{&rays_, &rays}}) {
+        model->cumulative.assign(1, 0.0);
+        for (double c : *costs) model->cumulative.push_back(model->cumulative.back() + c);
+        model->error = 0.0;
+    }
+    // The probe's own time is the pace of its rays until a region finishes.
+    const double probeSeconds = time_.cumulative.back(), probeRays = rays_.cumulative.back();
+    if (!(probeSeconds > 0.0) || !(probeRays > 0.0) || seconds.size() != rays.size()) {
+        time_.cumulative.clear();
+        rays_.cumulative.clear();
+    }
     regionsDone_ = 0;
     secondsWhenDone_ = 0.0;
     renderStart_ = Clock::now();
 }
 
+double Progress::CostModel::pace(std::size_t regions, double seconds) const {
+    if (regions > 0 && cumulative[regions] > 0.0) return seconds / cumulative[regions];
+    return cumulative.back() > 0.0 ? 1.0 : 0.0;  // seconds: the probe's own measure
+}
+
+const Progress::CostModel& Progress::bestModel() const { return rays_.error < time_.error ? rays_ : time_; }
+
 double Progress::secondsLeft(double elapsed, double fraction) {
-    if (cumulativeCost_.empty() || elapsed <= 0.0) return elapsed * (1.0 - fraction) / fraction;
-    const std::size_t regions = cumulativeCost_.size() - 1;
+    if (time_.cumulative.empty() || elapsed <= 0.0) return elapsed * (1.0 - fraction) / fraction;
+    const std::size_t regions = time_.cumulative.size() - 1;
     const auto done = std::min(regions, std::size_t(std::max(0.0, fraction) * double(regions) + 1e-9));
     if (done > regionsDone_) {
+        // Score each model on the regions just finished, predicted at the
+        // pace of those before them (the first region only sets the pace).
+        if (regionsDone_ > 0) {
+            const double taken = elapsed - secondsWhenDone_;
+            for (CostModel* m : {&time_, &rays_}) {
+                const double predicted = m->pace(regionsDone_, secondsWhenDone_) *
+                                         (m->cumulative[done] - m->cumulative[regionsDone_]);
+                if (predicted > 0.0 && taken > 0.0) m->error += std::abs(std::log(predicted / taken));
+            }
+        }
         regionsDone_ = done;
         secondsWhenDone_ = elapsed;
     }
-    const double expectedDone = cumulativeCost_[regionsDone_], expectedAll = cumulativeCost_.back();
-    // How the finished regions' time compared with their expectation
-    // (before the first is finished, the expectation as it is).
-    const double scale = regionsDone_ > 0 && expectedDone > 0.0 ? secondsWhenDone_ / expectedDone : 1.0;
-    const double ahead = scale * (expectedAll - expectedDone) - (elapsed - secondsWhenDone_);
-    // Past its expectation, the current region is taken to be nearly done.
-    return std::max(ahead, 0.02 * scale * (expectedAll - expectedDone));
+    if (regionsDone_ == regions) return 0.0;
+    const CostModel& m = bestModel();
+    const double costDone = m.cumulative[regionsDone_], costCurrent = m.cumulative[regionsDone_ + 1] - costDone;
+    const double costAfter = m.cumulative.back() - costDone - costCurrent;
+    // The rays model's pace before any region has finished: the probe's seconds a ray.
+    double pace = m.pace(regionsDone_, secondsWhenDone_);
+    if (regionsDone_ == 0 && &m == &rays_) pace = time_.cumulative.back() / rays_.cumulative.back();
+    const double currentLeft = std::max(0.0, pace * costCurrent - (elapsed - secondsWhenDone_));
+    // A current region past its expectation sets the pace as if it ended now;
+    // it is then taken to be nearly done.
+    const double paceNow = elapsed / (costDone + costCurrent);
+    return std::max(pace * costAfter + currentLeft, paceNow * costAfter) + 0.02 * paceNow * costCurrent;
 }
 
 void Progress::done() {

@@ -4,11 +4,15 @@
 //
 // The time left: a render's cost is uneven over the image (sky above, glass
 // below), and within a region the cheap pixels finish first, so
-// extrapolating the pixels done misleads. Given the expected time of each
-// region in the order the renderer finishes them (from a sparse render of
-// the same image, expectCost), the time left is the unfinished regions'
-// expected time, scaled by how the finished ones compared with theirs, less
-// the time the current one has had. Without it, the pixels' pace.
+// extrapolating the pixels done misleads. A sparse render of the same image
+// gives each region (in the order the renderer finishes them) two expected
+// costs, its time and its rays (expectCost). Neither is right everywhere: the
+// probe's time is right where cost is spread (a SphereFlake), but a small
+// region with a rare expensive pixel runs as long as that pixel alone and is
+// overstated; its rays miss that rays cost more deep in a BVH than in the
+// sky. The bar uses the one that has predicted the finished regions better:
+// the unfinished regions' cost at the pace the finished ones took it, less
+// the time the current one has had. Without an expectation, the pixels' pace.
 #pragma once
 
 #include <chrono>
@@ -32,8 +36,8 @@ public:
     // Erases the bar (before any message that follows the render).
     void done();
     bool enabled() const { return enabled_; }
-    // The expected seconds of each region, in order; the render starts now.
-    void expectCost(std::vector<double> regions);
+    // Each region's expected seconds and rays, in order; the render starts now.
+    void expectCost(const std::vector<double>& seconds, const std::vector<double>& rays);
     // The time left after `elapsed` seconds of rendering, with `fraction`
     // (regions finished plus the current one's share, over their count)
     // done. Also notes the regions finished.
@@ -44,7 +48,17 @@ private:
     void show(double fraction, std::uint64_t rays);
 
     bool enabled_;
-    std::vector<double> cumulativeCost_;  // expected seconds before each region, and of all
+    // One way of predicting the regions' cost: expected cost before each
+    // region and of all, and how far off its predictions of the finished
+    // regions were (the sum of |log(predicted / taken)|).
+    struct CostModel {
+        std::vector<double> cumulative;
+        double error = 0.0;
+        // Seconds a unit of cost, as the first `regions` regions took it.
+        double pace(std::size_t regions, double seconds) const;
+    };
+    const CostModel& bestModel() const;
+    CostModel time_, rays_;
     std::size_t regionsDone_ = 0;
     double secondsWhenDone_ = 0.0;       // the render's time when the last finished region ended
     Clock::time_point renderStart_;

@@ -39,6 +39,7 @@ struct RenderOptions {
     std::optional<double> tolerance;
     std::optional<std::uint64_t> treeBudget;
     std::string boundImage;
+    EncodingOptions encoding;
     std::vector<int> region;  // X0 Y0 X1 Y1, or empty
     bool allowRunaway = false;
     DeviceOptions device;
@@ -101,18 +102,19 @@ struct RenderOutcome {
     GpuRenderResult::Lanes lanes;
 };
 
-// For the progress bar's time left: what each region of the image costs,
-// in the order the renderer finishes them, timed on a render of one pixel in
-// 256 (every 16th row and column of the same image), region by region,
-// costing about 1/256 of the render. Time rather than rays: a ray's cost
-// varies over the image (deep in a BVH, or through empty space). Only for
-// renders long enough to show a bar for a while. `render` returns its
-// milliseconds.
+// For the progress bar's time left: the time and the rays each region of
+// the image costs, in the order the renderer finishes them, measured on a
+// render of one pixel in 256 (every 16th row and column of the same image),
+// region by region, costing about 1/256 of the render (Progress says which
+// of the two it trusts). From 256² camera rays on: the image's size says
+// little of the render's time (an amplifying scene at 1400² renders longer
+// than a simple one at 8192²), and the probe's 16² or more pixels cost
+// little. `render` returns its milliseconds and rays.
 template <class Render>
 void estimateCost(const Scene& scene, const RenderRequest& request, const std::vector<PixelWindow>& regions,
                   Progress& progress, RenderOutcome& outcome, Render render) {
     constexpr int kStride = 16;
-    constexpr double kMinCameraRays = 1 << 22;
+    constexpr double kMinCameraRays = 1 << 16;
     const PixelWindow area = request.area();
     const double cameraRays = double(area.width()) * area.height() * request.supersample * request.supersample;
     if (cameraRays < kMinCameraRays) return;
@@ -123,16 +125,19 @@ void estimateCost(const Scene& scene, const RenderRequest& request, const std::v
     probe.trace = request.trace;
     probe.cancel = request.cancel;
     const auto start = Clock::now();
-    std::vector<double> seconds;
+    std::vector<double> seconds, rays;
     for (const PixelWindow& r : regions) {
         const int x0 = std::min(r.x0 / kStride, probe.width - 1), y0 = std::min(r.y0 / kStride, probe.height - 1);
         probe.window = {x0, y0, std::max(r.x1 / kStride, x0 + 1), std::max(r.y1 / kStride, y0 + 1)};
-        // In the render's own time: the probe saw one pixel in (its share of) the region's.
+        // In the render's own terms: the probe saw one pixel in (its share of) the region's.
         const PixelWindow seen = probe.area();
-        seconds.push_back(1e-3 * render(probe) * double(r.width()) * r.height() / (double(seen.width()) * seen.height()));
+        const double share = double(r.width()) * r.height() / (double(seen.width()) * seen.height());
+        const auto [ms, probeRays] = render(probe);
+        seconds.push_back(1e-3 * ms * share);
+        rays.push_back(probeRays * share);
     }
     outcome.estimateMs = msSince(start);
-    progress.expectCost(std::move(seconds));
+    progress.expectCost(seconds, rays);
 }
 
 // The CPU reference finishes rows top to bottom: its regions are bands of rows.
@@ -221,6 +226,7 @@ CLI::App* RenderCommand::define(CLI::App& app) {
                   "Also write each pixel's truncation bound (how far it may be from the exact image) to FILE "
                   "(.pfm or .exr keep it unclamped)")
         ->check(kImageFormat);
+    addEncodingOptions(*c, o_.encoding);
     c->add_option("--region", o_.region,
                   "Render only pixels X0..X1-1, Y0..Y1-1 of the image, as an image of that window (for a "
                   "render farm: join the pieces with 'snell assemble')")
@@ -352,8 +358,9 @@ RenderOutcome RenderCommand::renderOnCpu(const Scene& scene, RenderRequest& requ
     if (progress.enabled())
         estimateCost(scene, request, rowBands(request.area()), progress, r, [&](const RenderRequest& probe) {
             const auto start = Clock::now();
-            renderer.render(probe);
-            return msSince(start);
+            RayCounts rays;
+            renderer.render(probe, &rays);
+            return std::pair(msSince(start), double(rays.total()));
         });
     const auto start = Clock::now();
     renderer.render(request, &r.rays);
@@ -380,9 +387,9 @@ RenderOutcome RenderCommand::renderOnGpu(const Scene& scene, RenderRequest& requ
         if (progress.enabled())
             estimateCost(scene, request, ComputeRenderer::tiles(request.area()), progress, r,
                          [&](const RenderRequest& probe) {
-                             const GpuRenderResult g = renderer.render(probe, o_.stats);
+                             const GpuRenderResult g = renderer.render(probe, true);
                              r.pipelineMs += g.pipelineMs;
-                             return g.renderMs;
+                             return std::pair(g.renderMs, double(g.rays.total()));
                          });
         const GpuRenderResult g = renderer.render(request, o_.stats);
         r.device = context.deviceName();
@@ -416,7 +423,7 @@ void RenderCommand::writeBoundImage(const RenderRequest& request, const std::vec
     Image image(area.width(), area.height());
     for (std::size_t i = 0; i < bound.size(); ++i)
         image.rgb[3 * i] = image.rgb[3 * i + 1] = image.rgb[3 * i + 2] = bound[i];
-    writeImage(o_.boundImage, image);
+    writeImage(o_.boundImage, image, {}, {}, o_.encoding.exr());
 }
 
 std::string RenderCommand::statsJson(const Scene& scene, const RenderRequest& request, const RenderOutcome& r,
@@ -472,7 +479,8 @@ OutputStream::OutputStream(const std::string& path, const Scene& scene, const Re
     // for it unless the encoder is slower, and memory stays bounded.
     constexpr int kQueuedRows = 1024;
     format_ = formatForPath(path);
-    writer_ = std::make_unique<BackgroundWriter>(ImageWriter::open(path, area.width(), area.height(), text, placement),
+    writer_ = std::make_unique<BackgroundWriter>(ImageWriter::open(path, area.width(), area.height(), text, placement,
+                                                                   o.encoding.exr()),
                                                  area.width(), kQueuedRows);
 }
 

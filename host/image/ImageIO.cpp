@@ -7,6 +7,7 @@
 #include <random>
 #include <sstream>
 
+#include <mutex>
 #include <thread>
 
 #include <ImfChannelList.h>
@@ -16,6 +17,7 @@
 #include <ImfInputFile.h>
 #include <ImfOutputFile.h>
 #include <ImfStringAttribute.h>
+#include <ImfThreading.h>
 #include <png.h>
 #include <unistd.h>
 
@@ -102,26 +104,44 @@ private:
     std::FILE* file_;
 };
 
-// OpenEXR, 32-bit float R, G, B, scan lines written as rows come. PIZ
-// (lossless wavelet) rather than ZIP: on rendered images it measured both
-// faster to write and smaller (docs/performance.md), and OpenEXR's own thread
-// pool compresses a band's blocks in parallel. A
-// piece of a larger image has that image as its display window and its own
-// pixels as the data window; text goes into string attributes.
+// OpenEXR compresses a band's blocks on its global thread pool, which has no
+// threads until it is given some: without this every block is compressed on
+// the calling thread, one after the other.
+void startExrThreads() {
+    static std::once_flag started;
+    std::call_once(started, [] { Imf::setGlobalThreadCount(int(std::max(1u, std::thread::hardware_concurrency()))); });
+}
+
+Imf::Compression exrLibraryCompression(ExrCompression compression) {
+    switch (compression) {
+    case ExrCompression::None: return Imf::NO_COMPRESSION;
+    case ExrCompression::Rle: return Imf::RLE_COMPRESSION;
+    case ExrCompression::Zip: return Imf::ZIP_COMPRESSION;
+    case ExrCompression::Piz: return Imf::PIZ_COMPRESSION;
+    }
+    return Imf::RLE_COMPRESSION;
+}
+
+// OpenEXR, 32-bit float R, G, B, scan lines written as rows come, compressed
+// as asked (ExrCompression) on OpenEXR's thread pool. A piece of a larger
+// image has that image as its display window and its own pixels as the data
+// window; text goes into string attributes.
 class ExrWriter : public ImageWriter {
 public:
-    ExrWriter(std::string path, int width, int height, const ImageText& text, const ImagePlacement& placement)
+    ExrWriter(std::string path, int width, int height, const ImageText& text, const ImagePlacement& placement,
+              ExrCompression compression)
         : ImageWriter(std::move(path), width, height), stream_(file_, path_) {
         const int fullWidth = placement.fullWidth > 0 ? placement.fullWidth : width;
         const int fullHeight = placement.fullHeight > 0 ? placement.fullHeight : height;
         origin_ = Imath::V2i(placement.x, placement.y);
         Imf::Header header(Imath::Box2i(Imath::V2i(0, 0), Imath::V2i(fullWidth - 1, fullHeight - 1)),
                            Imath::Box2i(origin_, origin_ + Imath::V2i(width - 1, height - 1)));
-        header.compression() = Imf::PIZ_COMPRESSION;
+        header.compression() = exrLibraryCompression(compression);
         for (const char* channel : {"R", "G", "B"}) header.channels().insert(channel, Imf::Channel(Imf::FLOAT));
         for (const auto& [key, value] : text) header.insert(key, Imf::StringAttribute(value));
-        const int threads = int(std::max(1u, std::thread::hardware_concurrency()));
-        guard([&] { output_ = std::make_unique<Imf::OutputFile>(stream_, header, threads); });
+        startExrThreads();
+        // Two line buffers per thread keep every thread fed (OpenEXR's rule).
+        guard([&] { output_ = std::make_unique<Imf::OutputFile>(stream_, header, Imf::globalThreadCount()); });
     }
     void writeRows(const float* rgb, int rows) override {
         guard([&] {
@@ -267,13 +287,30 @@ ImageWriter::~ImageWriter() {
     if (!committed_) std::remove(temporary_.c_str());
 }
 
+const char* exrCompressionName(ExrCompression compression) {
+    switch (compression) {
+    case ExrCompression::None: return "none";
+    case ExrCompression::Rle: return "rle";
+    case ExrCompression::Zip: return "zip";
+    case ExrCompression::Piz: return "piz";
+    }
+    return "rle";
+}
+
+ExrCompression exrCompressionNamed(const std::string& name) {
+    for (ExrCompression c : {ExrCompression::None, ExrCompression::Rle, ExrCompression::Zip, ExrCompression::Piz})
+        if (name == exrCompressionName(c)) return c;
+    throw ImageIOError("unknown EXR compression '" + name + "' (none, rle, zip or piz)");
+}
+
 std::unique_ptr<ImageWriter> ImageWriter::open(const std::string& path, int width, int height,
-                                               const ImageText& text, const ImagePlacement& placement) {
+                                               const ImageText& text, const ImagePlacement& placement,
+                                               ExrCompression compression) {
     switch (formatForPath(path)) {
     case ImageFormat::Png: return std::unique_ptr<ImageWriter>(new PngWriter(path, width, height, text));
     case ImageFormat::Ppm: return std::unique_ptr<ImageWriter>(new PpmWriter(path, width, height));
     case ImageFormat::Pfm: return std::unique_ptr<ImageWriter>(new PfmWriter(path, width, height));
-    case ImageFormat::Exr: return std::unique_ptr<ImageWriter>(new ExrWriter(path, width, height, text, placement));
+    case ImageFormat::Exr: return std::unique_ptr<ImageWriter>(new ExrWriter(path, width, height, text, placement, compression));
     }
     throw ImageIOError("unknown image format");
 }
@@ -297,8 +334,9 @@ void ImageWriter::commit() {
     committed_ = true;
 }
 
-void writeImage(const std::string& path, const Image& image, const ImageText& text, const ImagePlacement& placement) {
-    auto writer = ImageWriter::open(path, image.width, image.height, text, placement);
+void writeImage(const std::string& path, const Image& image, const ImageText& text, const ImagePlacement& placement,
+                ExrCompression compression) {
+    auto writer = ImageWriter::open(path, image.width, image.height, text, placement, compression);
     writer->writeRows(image.rgb.data(), image.height);
     writer->commit();
 }

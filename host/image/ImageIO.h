@@ -1,5 +1,5 @@
 // Image files: PNG (8-bit), PPM P6 (8-bit), PFM and OpenEXR (float,
-// unclamped; EXR through the OpenEXR library, 32-bit float, ZIP), chosen by
+// unclamped; EXR through the OpenEXR library, 32-bit float, lossless), chosen by
 // extension. Writing streams rows (an image of any size is written with
 // bounded memory) into a temporary file beside the target, renamed over it
 // only on commit(), so a failed or interrupted write never leaves a partial or
@@ -49,12 +49,25 @@ struct ImagePlacement {
     bool stored = false;  // read from the file (EXR)
 };
 
+// How EXR scan lines are compressed; every choice is lossless. Measured on
+// 8192² renders (docs/performance.md, "Writing images"): PIZ is the fastest
+// that compresses a detailed render (RLE leaves one whole, ZIP is slower and
+// no smaller); RLE is 2x faster on flat images, none faster still where the
+// disk is fast.
+enum class ExrCompression { None, Rle, Zip, Piz };
+inline constexpr ExrCompression kDefaultExrCompression = ExrCompression::Piz;
+// "none", "rle", "zip", "piz"
+const char* exrCompressionName(ExrCompression compression);
+// The compression named `name`; throws ImageIOError for an unknown name.
+ExrCompression exrCompressionNamed(const std::string& name);
+
 // Rows of width × 3 floats, top to bottom, in one or more calls.
 class ImageWriter {
 public:
     // Opens a temporary file beside `path`. Throws ImageIOError.
     static std::unique_ptr<ImageWriter> open(const std::string& path, int width, int height,
-                                             const ImageText& text = {}, const ImagePlacement& placement = {});
+                                             const ImageText& text = {}, const ImagePlacement& placement = {},
+                                             ExrCompression compression = kDefaultExrCompression);
     virtual ~ImageWriter();
     // The next `rows` rows (rgb floats, width * 3 per row).
     virtual void writeRows(const float* rgb, int rows) = 0;
@@ -72,7 +85,7 @@ protected:
 };
 
 void writeImage(const std::string& path, const Image& image, const ImageText& text = {},
-                const ImagePlacement& placement = {});
+                const ImagePlacement& placement = {}, ExrCompression compression = kDefaultExrCompression);
 // `placement`, if given, receives where the file says the image lies.
 Image readImage(const std::string& path, ImagePlacement* placement = nullptr);
 
