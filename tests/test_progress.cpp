@@ -1,6 +1,8 @@
 // The progress bar's time left (cli/Progress): which expectation it trusts,
 // and what it does when a region outlasts its expectation. Times are given,
 // not measured, so these tests are exact.
+#include <cmath>
+
 #include <gtest/gtest.h>
 
 #include "cli/Progress.h"
@@ -47,6 +49,15 @@ TEST(ProgressTimeLeft, ARegionPastItsExpectationSlowsThePaceOfTheRest) {
     const double left = progress.secondsLeft(6.0, 1.5 * kQuarter);
     EXPECT_GE(left, 6.0);
     EXPECT_LT(left, 7.0);
+}
+
+TEST(ProgressTimeLeft, RegionsTheProbeTimedAtNothingGiveAFiniteTimeLeft) {
+    Progress progress(false);
+    // A tiny first region can take no measurable time.
+    progress.expectCost({0, 1, 1, 1}, {1e3, 1e6, 1e6, 1e6});
+    const double left = progress.secondsLeft(0.5, 0.1);
+    EXPECT_TRUE(std::isfinite(left));
+    EXPECT_GE(left, 0.0);
 }
 
 TEST(ProgressTimeLeft, NothingLeftWhenEveryRegionIsDone) {

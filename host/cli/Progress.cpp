@@ -95,7 +95,7 @@ double Progress::secondsLeft(double elapsed, double fraction) {
     const double currentLeft = std::max(0.0, pace * costCurrent - (elapsed - secondsWhenDone_));
     // A current region past its expectation sets the pace as if it ended now;
     // it is then taken to be nearly done.
-    const double paceNow = elapsed / (costDone + costCurrent);
+    const double paceNow = costDone + costCurrent > 0.0 ? elapsed / (costDone + costCurrent) : pace;
     return std::max(pace * costAfter + currentLeft, paceNow * costAfter) + 0.02 * paceNow * costCurrent;
 }
 
