@@ -13,20 +13,22 @@ namespace {
 
 // Four regions, each a quarter of the bar; region i is done at fraction (i + 1) / 4.
 constexpr double kQuarter = 0.25;
+// Where a test is not about rays: no rays reported (the region's pixels are its progress).
+constexpr double kNoRays = 0.0;
 
 TEST(ProgressTimeLeft, WithoutAnExpectationFollowsThePixelsPace) {
     Progress progress(false);
-    EXPECT_DOUBLE_EQ(progress.secondsLeft(10.0, 0.25), 30.0);
+    EXPECT_DOUBLE_EQ(progress.secondsLeft(10.0, 0.25, kNoRays), 30.0);
 }
 
 TEST(ProgressTimeLeft, TrustsTheRaysWhereTheyPredictedTheFinishedRegions) {
     Progress progress(false);
     // The probe's time says the regions cost the same; its rays say the last two cost 4x.
     progress.expectCost({10, 10, 10, 10}, {1e6, 1e6, 4e6, 4e6});
-    progress.secondsLeft(1.0, 1 * kQuarter);
-    progress.secondsLeft(2.0, 2 * kQuarter);
+    progress.secondsLeft(1.0, 1 * kQuarter, kNoRays);
+    progress.secondsLeft(2.0, 2 * kQuarter, kNoRays);
     // The third region took 4 s, as its rays foretold: the last one takes 4 s too.
-    const double left = progress.secondsLeft(6.0, 3 * kQuarter);
+    const double left = progress.secondsLeft(6.0, 3 * kQuarter, kNoRays);
     EXPECT_NEAR(left, 4.0, 0.2);
 }
 
@@ -34,19 +36,19 @@ TEST(ProgressTimeLeft, TrustsTheProbesTimeWhereItPredictedTheFinishedRegions) {
     Progress progress(false);
     // The rays say the regions cost the same; the probe's time says the last two cost 3x.
     progress.expectCost({1, 1, 3, 3}, {1e6, 1e6, 1e6, 1e6});
-    progress.secondsLeft(2.0, 1 * kQuarter);
-    progress.secondsLeft(4.0, 2 * kQuarter);
-    const double left = progress.secondsLeft(10.0, 3 * kQuarter);
+    progress.secondsLeft(2.0, 1 * kQuarter, kNoRays);
+    progress.secondsLeft(4.0, 2 * kQuarter, kNoRays);
+    const double left = progress.secondsLeft(10.0, 3 * kQuarter, kNoRays);
     EXPECT_NEAR(left, 6.0, 0.3);
 }
 
 TEST(ProgressTimeLeft, ARegionPastItsExpectationSlowsThePaceOfTheRest) {
     Progress progress(false);
     progress.expectCost({1, 1, 1, 1}, {1e6, 1e6, 1e6, 1e6});
-    progress.secondsLeft(1.0, 1 * kQuarter);
+    progress.secondsLeft(1.0, 1 * kQuarter, kNoRays);
     // Region 1 was expected to take 1 s and has had 5: the two after it are
     // taken at the pace of 6 s for two regions at least.
-    const double left = progress.secondsLeft(6.0, 1.5 * kQuarter);
+    const double left = progress.secondsLeft(6.0, 1.5 * kQuarter, kNoRays);
     EXPECT_GE(left, 6.0);
     EXPECT_LT(left, 7.0);
 }
@@ -55,15 +57,40 @@ TEST(ProgressTimeLeft, RegionsTheProbeTimedAtNothingGiveAFiniteTimeLeft) {
     Progress progress(false);
     // A tiny first region can take no measurable time.
     progress.expectCost({0, 1, 1, 1}, {1e3, 1e6, 1e6, 1e6});
-    const double left = progress.secondsLeft(0.5, 0.1);
+    const double left = progress.secondsLeft(0.5, 0.1, kNoRays);
     EXPECT_TRUE(std::isfinite(left));
     EXPECT_GE(left, 0.0);
+}
+
+TEST(ProgressTimeLeft, ARegionAloneLearnsItsPaceFromItsOwnProgress) {
+    Progress progress(false);
+    // The probe says 100 s and 1e8 rays; after 10 s half the pixels are
+    // finished and their 4e7 rays with them: 4e7 of 4e7 + 0.5 * 1e8 is 4/9
+    // of the region, so 12.5 s are left, whatever the probe's time said.
+    progress.expectCost({100}, {1e8});
+    EXPECT_NEAR(progress.secondsLeft(10.0, 0.5, 4e7), 12.5, 1e-9);
+}
+
+TEST(ProgressTimeLeft, ARegionsOwnPaceCountsForMoreAsItGoesOn) {
+    Progress progress(false);
+    progress.expectCost({10, 10}, {1e6, 1e6});
+    progress.secondsLeft(10.0, 0.5, 1e6);  // region 0 took its 10 s
+    // Region 1 runs three times as fast as expected: the estimate lies
+    // between the expectation's remainder and the region's own, nearer the
+    // latter the further the region is.
+    const double early = progress.secondsLeft(11.0, 0.5 + 0.5 * 0.3, 1e6 + 0.3e6);  // own: 2.33 s; expected: 9 s
+    const double late = progress.secondsLeft(13.0, 0.5 + 0.5 * 0.9, 1e6 + 0.9e6);   // own: 0.33 s; expected: 7 s
+    EXPECT_LT(early, 9.0);
+    EXPECT_GT(early, 2.33);
+    EXPECT_LT(late, 1.5);
+    EXPECT_LT(late, early);
+    EXPECT_GT(late, 0.33);
 }
 
 TEST(ProgressTimeLeft, NothingLeftWhenEveryRegionIsDone) {
     Progress progress(false);
     progress.expectCost({1, 2}, {1e6, 2e6});
-    EXPECT_DOUBLE_EQ(progress.secondsLeft(3.0, 1.0), 0.0);
+    EXPECT_DOUBLE_EQ(progress.secondsLeft(3.0, 1.0, kNoRays), 0.0);
 }
 
 }  // namespace

@@ -21,7 +21,7 @@ void Progress::show(double fraction, std::uint64_t rays) {
     if (!enabled_) return;
     const auto now = Clock::now();
     // Every report counts for the estimate (it notes the regions finished), a few a second are shown.
-    const double left = secondsLeft(std::chrono::duration<double>(now - renderStart_).count(), fraction);
+    const double left = secondsLeft(std::chrono::duration<double>(now - renderStart_).count(), fraction, double(rays));
     if (fraction < 1.0 && now - last_ < std::chrono::milliseconds(250)) return;
     last_ = now;
     shown_ = true;
@@ -57,6 +57,7 @@ void Progress::expectCost(const std::vector<double>& seconds, const std::vector<
     }
     regionsDone_ = 0;
     secondsWhenDone_ = 0.0;
+    raysWhenDone_ = 0.0;
     renderStart_ = Clock::now();
 }
 
@@ -67,7 +68,7 @@ double Progress::CostModel::pace(std::size_t regions, double seconds) const {
 
 const Progress::CostModel& Progress::bestModel() const { return rays_.error < time_.error ? rays_ : time_; }
 
-double Progress::secondsLeft(double elapsed, double fraction) {
+double Progress::secondsLeft(double elapsed, double fraction, double rays) {
     if (time_.cumulative.empty() || elapsed <= 0.0) return elapsed * (1.0 - fraction) / fraction;
     const std::size_t regions = time_.cumulative.size() - 1;
     const auto done = std::min(regions, std::size_t(std::max(0.0, fraction) * double(regions) + 1e-9));
@@ -84,19 +85,40 @@ double Progress::secondsLeft(double elapsed, double fraction) {
         }
         regionsDone_ = done;
         secondsWhenDone_ = elapsed;
+        raysWhenDone_ = rays;
     }
     if (regionsDone_ == regions) return 0.0;
     const CostModel& m = bestModel();
     const double costDone = m.cumulative[regionsDone_], costCurrent = m.cumulative[regionsDone_ + 1] - costDone;
     const double costAfter = m.cumulative.back() - costDone - costCurrent;
-    // The rays model's pace before any region has finished: the probe's seconds a ray.
+    const double inRegion = elapsed - secondsWhenDone_;
+    const double progress = regionProgress(fraction * double(regions) - double(regionsDone_), rays - raysWhenDone_);
     double pace = m.pace(regionsDone_, secondsWhenDone_);
-    if (regionsDone_ == 0 && &m == &rays_) pace = time_.cumulative.back() / rays_.cumulative.back();
-    const double currentLeft = std::max(0.0, pace * costCurrent - (elapsed - secondsWhenDone_));
-    // A current region past its expectation sets the pace as if it ended now;
-    // it is then taken to be nearly done.
+    if (regionsDone_ == 0) {
+        // No region finished yet: the current one's own pace once it has
+        // made some progress (the probe's time overstates a small probe whose
+        // few expensive pixels ran alone), else the probe's.
+        if (progress > 0.05 && inRegion > 0.0 && costCurrent > 0.0) pace = inRegion / (progress * costCurrent);
+        else if (&m == &rays_) pace = time_.cumulative.back() / rays_.cumulative.back();
+    }
+    // The current region: its expectation at that pace, and its own pace
+    // over its progress, trusted in proportion to that progress.
+    const double expectedLeft = std::max(0.0, pace * costCurrent - inRegion);
+    const double ownLeft = progress > 0.01 ? inRegion * (1.0 - progress) / progress : expectedLeft;
+    const double currentLeft = (1.0 - progress) * expectedLeft + progress * ownLeft;
+    // A current region past its expectation sets the pace as if it ended now.
     const double paceNow = costDone + costCurrent > 0.0 ? elapsed / (costDone + costCurrent) : pace;
-    return std::max(pace * costAfter + currentLeft, paceNow * costAfter) + 0.02 * paceNow * costCurrent;
+    return std::max(pace * costAfter + currentLeft, paceNow * costAfter);
+}
+
+double Progress::regionProgress(double pixels, double rays) const {
+    pixels = std::clamp(pixels, 0.0, 1.0);
+    const std::size_t k = regionsDone_;
+    // The region's expected rays: the probe's, scaled as the finished regions' rays ran against theirs.
+    const double scale = k > 0 && rays_.cumulative[k] > 0.0 ? raysWhenDone_ / rays_.cumulative[k] : 1.0;
+    const double expected = (rays_.cumulative[k + 1] - rays_.cumulative[k]) * scale;
+    if (!(rays > 0.0) || !(expected > 0.0)) return std::min(pixels, 0.999);
+    return std::min(rays / (rays + (1.0 - pixels) * expected), 0.999);
 }
 
 void Progress::done() {

@@ -11,8 +11,12 @@
 // region with a rare expensive pixel runs as long as that pixel alone and is
 // overstated; its rays miss that rays cost more deep in a BVH than in the
 // sky. The bar uses the one that has predicted the finished regions better:
-// the unfinished regions' cost at the pace the finished ones took it, less
-// the time the current one has had. Without an expectation, the pixels' pace.
+// the unfinished regions' cost at the pace the finished ones took it. The
+// current region is that expectation, less the time it has had, weighed
+// against its own pace over its progress (its rays so far against those plus
+// the expected rays of its unfinished pixels), which counts for more as the
+// region goes on; before any region has finished, that progress also sets
+// the pace. Without an expectation, the pixels' pace.
 #pragma once
 
 #include <chrono>
@@ -39,9 +43,9 @@ public:
     // Each region's expected seconds and rays, in order; the render starts now.
     void expectCost(const std::vector<double>& seconds, const std::vector<double>& rays);
     // The time left after `elapsed` seconds of rendering, with `fraction`
-    // (regions finished plus the current one's share, over their count)
-    // done. Also notes the regions finished.
-    double secondsLeft(double elapsed, double fraction);
+    // (regions finished plus the current one's share of pixels, over their
+    // count) done and `rays` traced. Also notes the regions finished.
+    double secondsLeft(double elapsed, double fraction, double rays);
 
 private:
     using Clock = std::chrono::steady_clock;
@@ -58,9 +62,13 @@ private:
         double pace(std::size_t regions, double seconds) const;
     };
     const CostModel& bestModel() const;
+    // How far the current region is, 0 to 1, from its share of pixels
+    // finished and the rays traced in it.
+    double regionProgress(double pixels, double rays) const;
     CostModel time_, rays_;
     std::size_t regionsDone_ = 0;
     double secondsWhenDone_ = 0.0;       // the render's time when the last finished region ended
+    double raysWhenDone_ = 0.0;          // and its rays traced by then
     Clock::time_point renderStart_;
     bool shown_ = false;
     std::size_t width_ = 0;
