@@ -30,11 +30,19 @@ const CLI::Validator kFinite(
     },
     "FINITE");
 
+namespace {
+std::vector<std::string> exrCompressionNames() {
+    std::vector<std::string> names;
+    for (ExrCompression c : kExrCompressions) names.emplace_back(exrCompressionName(c));
+    return names;
+}
+}  // namespace
+
 void addEncodingOptions(CLI::App& command, EncodingOptions& o) {
     command.add_option("--exr-compression", o.exrCompression,
                        "How an .exr output is compressed, all lossless: piz (default), rle (faster on flat "
                        "images, useless on detailed ones), zip (slower), none (largest)")
-        ->check(CLI::IsMember({"piz", "rle", "zip", "none"}));
+        ->check(CLI::IsMember(exrCompressionNames()));
 }
 
 void addDeviceOptions(CLI::App& command, DeviceOptions& o) {

@@ -298,9 +298,12 @@ const char* exrCompressionName(ExrCompression compression) {
 }
 
 ExrCompression exrCompressionNamed(const std::string& name) {
-    for (ExrCompression c : {ExrCompression::None, ExrCompression::Rle, ExrCompression::Zip, ExrCompression::Piz})
+    std::string names;
+    for (ExrCompression c : kExrCompressions) {
         if (name == exrCompressionName(c)) return c;
-    throw ImageIOError("unknown EXR compression '" + name + "' (none, rle, zip or piz)");
+        names += std::string(names.empty() ? "" : ", ") + exrCompressionName(c);
+    }
+    throw ImageIOError("unknown EXR compression '" + name + "' (" + names + ")");
 }
 
 std::unique_ptr<ImageWriter> ImageWriter::open(const std::string& path, int width, int height,

@@ -55,6 +55,8 @@ struct ImagePlacement {
 // long for a file 5 % smaller); RLE is 2x faster on flat images, none faster
 // still where the disk is fast.
 enum class ExrCompression { None, Rle, Zip, Piz };
+inline constexpr ExrCompression kExrCompressions[] = {ExrCompression::Piz, ExrCompression::Rle, ExrCompression::Zip,
+                                                      ExrCompression::None};
 inline constexpr ExrCompression kDefaultExrCompression = ExrCompression::Piz;
 // "none", "rle", "zip", "piz"
 const char* exrCompressionName(ExrCompression compression);
