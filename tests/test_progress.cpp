@@ -87,6 +87,14 @@ TEST(ProgressTimeLeft, ARegionsOwnPaceCountsForMoreAsItGoesOn) {
     EXPECT_GT(late, 0.33);
 }
 
+TEST(ProgressTimeLeft, ARegionPastItsExpectationWithNoProgressIsNotDone) {
+    Progress progress(false);
+    progress.expectCost({1, 1}, {1e6, 1e6});
+    progress.secondsLeft(1.0, 0.5, 1e6);
+    // The last region was expected to take 1 s, has had 3 and finished nothing yet.
+    EXPECT_GT(progress.secondsLeft(4.0, 0.5, 1e6), 0.0);
+}
+
 TEST(ProgressTimeLeft, NothingLeftWhenEveryRegionIsDone) {
     Progress progress(false);
     progress.expectCost({1, 2}, {1e6, 2e6});

@@ -103,11 +103,13 @@ double Progress::secondsLeft(double elapsed, double fraction, double rays) {
     }
     // The current region: its expectation at that pace, and its own pace
     // over its progress, trusted in proportion to that progress.
+    // A current region past its expectation sets the pace as if it ended now
+    // (and, where it has shown no progress, is taken to be nearly done).
+    const double paceNow = costDone + costCurrent > 0.0 ? elapsed / (costDone + costCurrent) : pace;
     const double expectedLeft = std::max(0.0, pace * costCurrent - inRegion);
     const double ownLeft = progress > 0.01 ? inRegion * (1.0 - progress) / progress : expectedLeft;
-    const double currentLeft = (1.0 - progress) * expectedLeft + progress * ownLeft;
-    // A current region past its expectation sets the pace as if it ended now.
-    const double paceNow = costDone + costCurrent > 0.0 ? elapsed / (costDone + costCurrent) : pace;
+    const double currentLeft = progress > 0.0 ? (1.0 - progress) * expectedLeft + progress * ownLeft
+                                              : std::max(expectedLeft, 0.02 * paceNow * costCurrent);
     return std::max(pace * costAfter + currentLeft, paceNow * costAfter);
 }
 
