@@ -101,11 +101,11 @@ double Progress::secondsLeft(double elapsed, double fraction, double rays) {
         if (progress > 0.05 && inRegion > 0.0 && costCurrent > 0.0) pace = inRegion / (progress * costCurrent);
         else if (&m == &rays_) pace = time_.cumulative.back() / rays_.cumulative.back();
     }
-    // The current region: its expectation at that pace, and its own pace
-    // over its progress, trusted in proportion to that progress.
-    // A current region past its expectation sets the pace as if it ended now
-    // (and, where it has shown no progress, is taken to be nearly done).
+    // A current region past its expectation sets the pace of the rest as if it ended now.
     const double paceNow = costDone + costCurrent > 0.0 ? elapsed / (costDone + costCurrent) : pace;
+    // The current region: its expectation at that pace, and its own pace over
+    // its progress, trusted in proportion to that progress; one past its
+    // expectation with no progress shown is taken to be nearly done.
     const double expectedLeft = std::max(0.0, pace * costCurrent - inRegion);
     const double ownLeft = progress > 0.01 ? inRegion * (1.0 - progress) / progress : expectedLeft;
     const double currentLeft = progress > 0.0 ? (1.0 - progress) * expectedLeft + progress * ownLeft
