@@ -221,7 +221,8 @@ struct SlotState {
 struct OutputPixel {
     vec4 colour;      // rgb: the colour (unclamped); a: its truncation bound, negative where not finite
     vec4 truncation;  // x: the estimated error where it stopped on one (render/Truncation.h), else −1;
-                      // y: 1 where the tree budget stopped it; z: 1 where it ended over the tolerance
+                      // y: 1 where the tree budget stopped it; z: 1 where it ended over the tolerance;
+                      // w: the rays (closest-hit queries) its trees traced, its cost (RenderRequest::rayImage)
 };
 
 // A ray waiting to be traced (SPEC §4 ray tree, depth first). Its medium stack

@@ -791,7 +791,7 @@ void finishPixel(uint slot, inout SlotState state, StepOutcome o, uint shadowRay
     bool overTolerance = tolerance > 0.0 && !o.certified && !o.settled;
     outputPixels[state.pixel] = OutputPixel(
         vec4(state.lower.rgb, o.unbounded ? -o.bound : o.bound),
-        vec4(o.settled ? o.estimate : -1.0, float(state.overBudget), overTolerance ? 1.0 : 0.0, 0.0));
+        vec4(o.settled ? o.estimate : -1.0, float(state.overBudget), overTolerance ? 1.0 : 0.0, float(state.treeRays)));
     uint finished = state.finished + 1u;
     uint rays = state.rays;
     state = freshPixel(takePixel());

@@ -369,3 +369,49 @@ TEST(GpuResume, SuspendingNeverChangesTheImage) {
 }
 
 }  // namespace
+
+namespace {
+
+// What the progress bar's estimate takes from the renderer: each pixel's
+// rays (its closest-hit queries: the rays the progress reports, but for the
+// shadow rays), and with an expected cost the share of each tile done, which
+// never changes the image.
+TEST(GpuProgress, PixelRaysAndSharesOfTheTile) {
+    const snell::Scene scene = snell::parseSceneFile(SNELL_SOURCE_DIR "/scenes/glass.scn");
+    snell::RenderRequest request;
+    request.width = request.height = 48;
+    request.camera = snell::Camera::fromSpec(48, scene.halfWidth);
+    request.trace = snell::kDefaultSettings;
+    snell::ComputeRenderer gpu(context(), scene, request.camera);
+    std::vector<float> pixelRays;
+    request.rayImage = &pixelRays;
+    std::uint64_t reportedRays = 0;
+    request.progress = [&](double, std::uint64_t rays) { reportedRays = rays; };
+    const snell::GpuRenderResult counted = gpu.render(request, true);
+    ASSERT_EQ(pixelRays.size(), std::size_t(48 * 48));
+    double sum = 0.0;
+    for (float r : pixelRays) {
+        EXPECT_GE(r, 1.0f);  // the camera ray at least
+        sum += r;
+    }
+    EXPECT_EQ(sum + double(counted.rays.shadow), double(reportedRays));
+
+    // The cost map, one cell per 4 × 4 pixels, from those rays.
+    snell::CostMap cost{4, 12, 12, std::vector<float>(12 * 12, 0.0f)};
+    for (int y = 0; y < 48; ++y)
+        for (int x = 0; x < 48; ++x) cost.cells[(y / 4) * 12 + x / 4] += pixelRays[y * 48 + x];
+    std::vector<double> shares;
+    request.rayImage = nullptr;
+    request.expectedCost = &cost;
+    request.progress = [&](double fraction, std::uint64_t) { shares.push_back(fraction); };
+    const snell::GpuRenderResult weighed = gpu.render(request, false);
+    ASSERT_FALSE(shares.empty());
+    for (double f : shares) {
+        EXPECT_GE(f, 0.0);
+        EXPECT_LE(f, 1.0);
+    }
+    EXPECT_EQ(shares.back(), 1.0);
+    EXPECT_EQ(weighed.image.rgb, counted.image.rgb);
+}
+
+}  // namespace

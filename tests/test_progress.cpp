@@ -46,11 +46,12 @@ TEST(ProgressTimeLeft, ARegionPastItsExpectationSlowsThePaceOfTheRest) {
     Progress progress(false);
     progress.expectCost({1, 1, 1, 1}, {1e6, 1e6, 1e6, 1e6});
     progress.secondsLeft(1.0, 1 * kQuarter, kNoRays);
-    // Region 1 was expected to take 1 s and has had 5: the two after it are
-    // taken at the pace of 6 s for two regions at least.
+    // Region 1 was expected to take 1 s and has had 5 for half its pixels:
+    // it has about 5 s left, and the two after it are taken at a pace slower
+    // than the first region's (1 s each), and no slower than its own (5 s each).
     const double left = progress.secondsLeft(6.0, 1.5 * kQuarter, kNoRays);
-    EXPECT_GE(left, 6.0);
-    EXPECT_LT(left, 7.0);
+    EXPECT_GT(left, 5.0 + 2 * 1.0);
+    EXPECT_LE(left, 5.0 + 2 * 5.0);
 }
 
 TEST(ProgressTimeLeft, RegionsTheProbeTimedAtNothingGiveAFiniteTimeLeft) {
@@ -99,6 +100,24 @@ TEST(ProgressTimeLeft, NothingLeftWhenEveryRegionIsDone) {
     Progress progress(false);
     progress.expectCost({1, 2}, {1e6, 2e6});
     EXPECT_DOUBLE_EQ(progress.secondsLeft(3.0, 1.0, kNoRays), 0.0);
+}
+
+TEST(ProgressTimeLeft, AShareOfTimeIsTheRenderersForecastOfItsRegion) {
+    Progress progress(false);
+    // The renderer reports its region by the share of its time done
+    // (RenderRequest::expectedCost): half of the last region in 2 s leaves 2 s,
+    // whatever the probe expected of it.
+    progress.expectCost({1, 10}, {1e6, 1e6}, true);
+    progress.secondsLeft(1.0, 0.5, kNoRays);
+    EXPECT_DOUBLE_EQ(progress.secondsLeft(3.0, 0.75, kNoRays), 2.0);
+}
+
+TEST(ProgressTimeLeft, AShareOfPixelsIsWeighedAgainstTheExpectation) {
+    Progress progress(false);
+    // The same as a share of pixels: the probe's 10 s for the region still counts.
+    progress.expectCost({1, 10}, {1e6, 1e6});
+    progress.secondsLeft(1.0, 0.5, kNoRays);
+    EXPECT_GT(progress.secondsLeft(3.0, 0.75, kNoRays), 2.0);
 }
 
 }  // namespace

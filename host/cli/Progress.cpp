@@ -42,8 +42,9 @@ void Progress::show(double fraction, std::uint64_t rays) {
     std::fflush(stderr);
 }
 
-void Progress::expectCost(const std::vector<double>& seconds, const std::vector<double>& rays) {
+void Progress::expectCost(const std::vector<double>& seconds, const std::vector<double>& rays, bool sharesOfTime) {
     std::lock_guard<std::mutex> lock(mutex_);
+    sharesOfTime_ = sharesOfTime;
     for (auto [model, costs] : {std::pair{&time_, &seconds}, std::pair{&rays_, &rays}}) {
         model->cumulative.assign(1, 0.0);
         for (double c : *costs) model->cumulative.push_back(model->cumulative.back() + c);
@@ -92,23 +93,26 @@ double Progress::secondsLeft(double elapsed, double fraction, double rays) {
     const double costDone = m.cumulative[regionsDone_], costCurrent = m.cumulative[regionsDone_ + 1] - costDone;
     const double costAfter = m.cumulative.back() - costDone - costCurrent;
     const double inRegion = elapsed - secondsWhenDone_;
-    const double progress = regionProgress(fraction * double(regions) - double(regionsDone_), rays - raysWhenDone_);
+    const double share = fraction * double(regions) - double(regionsDone_);
+    const double progress = sharesOfTime_ ? std::clamp(share, 0.0, 0.999) : regionProgress(share, rays - raysWhenDone_);
+    // The pace of the work done so far, the current region's share of its
+    // cost included once it has made some progress (the probe's time
+    // overstates a small probe whose few expensive pixels ran alone); before
+    // that, the finished regions', or with none, the probe's.
     double pace = m.pace(regionsDone_, secondsWhenDone_);
-    if (regionsDone_ == 0) {
-        // No region finished yet: the current one's own pace once it has
-        // made some progress (the probe's time overstates a small probe whose
-        // few expensive pixels ran alone), else the probe's.
-        if (progress > 0.05 && inRegion > 0.0 && costCurrent > 0.0) pace = inRegion / (progress * costCurrent);
-        else if (&m == &rays_) pace = time_.cumulative.back() / rays_.cumulative.back();
-    }
+    if (progress > 0.05 && inRegion > 0.0 && costCurrent > 0.0) pace = elapsed / (costDone + progress * costCurrent);
+    else if (regionsDone_ == 0 && &m == &rays_) pace = time_.cumulative.back() / rays_.cumulative.back();
     // A current region past its expectation sets the pace of the rest as if it ended now.
     const double paceNow = costDone + costCurrent > 0.0 ? elapsed / (costDone + costCurrent) : pace;
     // The current region: its expectation at that pace, and its own pace over
-    // its progress, trusted in proportion to that progress; one past its
-    // expectation with no progress shown is taken to be nearly done.
+    // its progress, trusted in proportion to that progress (a share of its
+    // time is the renderer's own forecast, trusted fully from a fifth on);
+    // one past its expectation with no progress shown is taken to be nearly
+    // done.
     const double expectedLeft = std::max(0.0, pace * costCurrent - inRegion);
     const double ownLeft = progress > 0.01 ? inRegion * (1.0 - progress) / progress : expectedLeft;
-    const double currentLeft = progress > 0.0 ? (1.0 - progress) * expectedLeft + progress * ownLeft
+    const double trust = sharesOfTime_ ? std::min(1.0, progress / 0.2) : progress;
+    const double currentLeft = progress > 0.0 ? (1.0 - trust) * expectedLeft + trust * ownLeft
                                               : std::max(expectedLeft, 0.02 * paceNow * costCurrent);
     return std::max(pace * costAfter + currentLeft, paceNow * costAfter);
 }

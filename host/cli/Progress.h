@@ -14,9 +14,10 @@
 // the unfinished regions' cost at the pace the finished ones took it. The
 // current region is that expectation, less the time it has had, weighed
 // against its own pace over its progress (its rays so far against those plus
-// the expected rays of its unfinished pixels), which counts for more as the
-// region goes on; before any region has finished, that progress also sets
-// the pace. Without an expectation, the pixels' pace.
+// the expected rays of its unfinished pixels, or where the renderer reports
+// it, the share of its time done by the renderer's own forecast), which
+// counts for more as the region goes on; that progress also counts in the
+// pace of the rest. Without an expectation, the pixels' pace.
 #pragma once
 
 #include <chrono>
@@ -41,7 +42,9 @@ public:
     void done();
     bool enabled() const { return enabled_; }
     // Each region's expected seconds and rays, in order; the render starts now.
-    void expectCost(const std::vector<double>& seconds, const std::vector<double>& rays);
+    // `sharesOfTime`: the renderer reports the region in progress by the
+    // share of its time done (RenderRequest::expectedCost), not of its pixels.
+    void expectCost(const std::vector<double>& seconds, const std::vector<double>& rays, bool sharesOfTime = false);
     // The time left after `elapsed` seconds of rendering, with `fraction`
     // (regions finished plus the current one's share of pixels, over their
     // count) done and `rays` traced. Also notes the regions finished.
@@ -66,6 +69,7 @@ private:
     // finished and the rays traced in it.
     double regionProgress(double pixels, double rays) const;
     CostModel time_, rays_;
+    bool sharesOfTime_ = false;
     std::size_t regionsDone_ = 0;
     double secondsWhenDone_ = 0.0;       // the render's time when the last finished region ended
     double raysWhenDone_ = 0.0;          // and its rays traced by then

@@ -109,10 +109,13 @@ struct RenderOutcome {
 // of the two it trusts). From 256² camera rays on: the image's size says
 // little of the render's time (an amplifying scene at 1400² renders longer
 // than a simple one at 8192²), and the probe's 16² or more pixels cost
-// little. `render` returns its milliseconds and rays.
+// little. `render` returns its milliseconds and rays. With `map`, also each
+// probe pixel's rays (where the renderer counts them): the cost of the
+// 16 × 16 pixels around it, by which the renderer weighs the pixels of the
+// region in progress.
 template <class Render>
 void estimateCost(const Scene& scene, const RenderRequest& request, const std::vector<PixelWindow>& regions,
-                  Progress& progress, RenderOutcome& outcome, Render render) {
+                  Progress& progress, RenderOutcome& outcome, Render render, CostMap* map = nullptr) {
     constexpr int kStride = 16;
     constexpr double kMinCameraRays = 1 << 16;
     const PixelWindow area = request.area();
@@ -126,18 +129,26 @@ void estimateCost(const Scene& scene, const RenderRequest& request, const std::v
     probe.cancel = request.cancel;
     const auto start = Clock::now();
     std::vector<double> seconds, rays;
+    std::vector<float> pixelRays;
+    if (map) *map = CostMap{kStride, probe.width, probe.height, std::vector<float>(std::size_t(probe.width) * probe.height)};
     for (const PixelWindow& r : regions) {
         const int x0 = std::min(r.x0 / kStride, probe.width - 1), y0 = std::min(r.y0 / kStride, probe.height - 1);
         probe.window = {x0, y0, std::max(r.x1 / kStride, x0 + 1), std::max(r.y1 / kStride, y0 + 1)};
         // In the render's own terms: the probe saw one pixel in (its share of) the region's.
         const PixelWindow seen = probe.area();
         const double share = double(r.width()) * r.height() / (double(seen.width()) * seen.height());
+        probe.rayImage = map ? &pixelRays : nullptr;
         const auto [ms, probeRays] = render(probe);
         seconds.push_back(1e-3 * ms * share);
         rays.push_back(probeRays * share);
+        if (map && pixelRays.size() == std::size_t(seen.width()) * seen.height())
+            for (int y = 0; y < seen.height(); ++y)
+                std::copy_n(pixelRays.begin() + std::ptrdiff_t(y) * seen.width(), seen.width(),
+                            map->cells.begin() + std::ptrdiff_t(seen.y0 + y) * map->width + seen.x0);
     }
     outcome.estimateMs = msSince(start);
-    progress.expectCost(seconds, rays);
+    if (map && std::all_of(map->cells.begin(), map->cells.end(), [](float c) { return c == 0.0f; })) *map = {};
+    progress.expectCost(seconds, rays, map && !map->empty());
 }
 
 // The CPU reference finishes rows top to bottom: its regions are bands of rows.
@@ -384,14 +395,18 @@ RenderOutcome RenderCommand::renderOnGpu(const Scene& scene, RenderRequest& requ
         if (const std::uint32_t budget = loopBudgetOverride()) renderer.forceLoopBudget(budget);
         renderer.countLanes(o_.countLanes);
         // The probe compiles the pipeline (the same one: same settings), which belongs to pipelineMs.
+        CostMap expectedCost;
         if (progress.enabled())
             estimateCost(scene, request, ComputeRenderer::tiles(request.area()), progress, r,
                          [&](const RenderRequest& probe) {
                              const GpuRenderResult g = renderer.render(probe, true);
                              r.pipelineMs += g.pipelineMs;
                              return std::pair(g.renderMs, double(g.rays.total()));
-                         });
+                         },
+                         &expectedCost);
+        if (!expectedCost.empty()) request.expectedCost = &expectedCost;
         const GpuRenderResult g = renderer.render(request, o_.stats);
+        request.expectedCost = nullptr;  // expectedCost ends here
         r.device = context.deviceName();
         r.traversal = renderer.traversal();
         r.uploadMs = renderer.uploadMs();

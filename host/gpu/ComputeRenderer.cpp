@@ -11,6 +11,7 @@
 
 #include "common/Clock.h"
 #include "gpu/DriverProbe.h"
+#include "render/WorkgroupSchedule.h"
 #include "trace_comp_spv.h"       // generated at build time from shaders/trace.comp
 #include "trace_fp64_comp_spv.h"  // the same, compiled with SNELL_FP64
 #include "trace_ray_query_comp_spv.h"  // the same, compiled with SNELL_RAY_QUERY
@@ -413,6 +414,19 @@ struct ComputeRenderer::Progress {
     std::uint64_t raysBefore = 0;
     int tilesDone = 0;
     TruncationReport truncation;
+    // With an expected cost (RenderRequest::expectedCost), of the tile in
+    // progress: each workgroup's expected cost before each of its runs of
+    // pixels, in the order it takes them (trace.comp, takePixel), and the
+    // tile's in all.
+    std::vector<std::vector<double>> costBefore;
+    double tileCost = 0.0;
+    // When the tile started, and when each workgroup was first seen running
+    // and seen finished (seconds into the tile; negative: not yet); the most
+    // workgroups seen running at once in the render.
+    Clock::time_point tileStart;
+    double lastReport = 0.0;
+    std::vector<double> startedAt, finishedAt;
+    std::size_t running = 1;
     // While a dispatch runs the host wakes a few times a second for this:
     // progress read from the invocations' states, and Ctrl-C.
     std::function<void()> whileRunning;
@@ -582,19 +596,88 @@ void ComputeRenderer::firstDispatch(Pipeline& p) {
     });
 }
 
+// The tile's expected cost in the order its pixels are taken: the tile is
+// dealt to the workgroups in runs of a workgroup's size, run r to workgroup
+// r mod W, and each workgroup takes its runs in order (trace.comp,
+// takePixel), so what a workgroup has finished is, but for the pixels in
+// progress, the start of its runs.
+void ComputeRenderer::expectTileCost(const RenderRequest& request, const TilePlan& plan,
+                                     const gpu::TileParams& tile, Progress& progress) const {
+    progress.costBefore.clear();
+    progress.tileCost = 0.0;
+    progress.tileStart = Clock::now();
+    progress.lastReport = 0.0;
+    if (!request.expectedCost || request.expectedCost->empty()) return;
+    const CostMap& map = *request.expectedCost;
+    const std::uint64_t run = SNELL_WORKGROUP_SIZE, workgroups = plan.invocations / run;
+    const std::uint64_t pixels = std::uint64_t(tile.width) * tile.height, runs = (pixels + run - 1) / run;
+    progress.costBefore.assign(workgroups, std::vector<double>(1, 0.0));
+    for (std::uint64_t r = 0; r < runs; ++r) {
+        double cost = 0.0;
+        for (std::uint64_t k = r * run; k < std::min(pixels, (r + 1) * run); ++k)
+            cost += map.at(int(tile.originX + k % tile.width), int(tile.originY + k / tile.width));
+        std::vector<double>& before = progress.costBefore[r % workgroups];
+        before.push_back(before.back() + cost);
+        progress.tileCost += cost;
+    }
+    progress.startedAt.assign(workgroups, -1.0);
+    progress.finishedAt.assign(workgroups, -1.0);
+}
+
 // The request's progress callback: finished tiles plus the share of the
-// current tile's pixels its invocations finished, and the rays so far.
+// current tile done, and the rays so far. The share is of the tile's pixels
+// finished, or with an expected cost, of its time: the time so far against
+// that and the time its workgroups have left (WorkgroupSchedule), once they
+// have shown their pace.
 void ComputeRenderer::reportProgress(const Pipeline& p, const RenderRequest& request, const TilePlan& plan,
                                      const gpu::TileParams& tile, Progress& progress, bool tileDone) const {
     const auto* states = static_cast<const gpu::SlotState*>(p.slotStates.mapped);
+    const std::uint64_t run = SNELL_WORKGROUP_SIZE, workgroups = plan.invocations / run;
+    const std::uint64_t pixels = std::uint64_t(tile.width) * tile.height;
+    const double now = std::chrono::duration<double>(Clock::now() - progress.tileStart).count();
+    const double seenAt = 0.5 * (progress.lastReport + now);  // between the last report and this one
     std::uint64_t finished = 0, rays = progress.raysBefore;
-    for (VkDeviceSize k = 0; k < plan.invocations; ++k) {
-        finished += states[k].finished;
-        rays += states[k].rays;
+    double costDone = 0.0;
+    std::size_t runningNow = 0;
+    std::vector<WorkgroupWork> work(progress.tileCost > 0.0 ? workgroups : 0);
+    for (std::uint64_t w = 0; w < workgroups; ++w) {
+        std::uint64_t ofWorkgroup = 0;
+        for (std::uint64_t k = w * run; k < (w + 1) * run; ++k) {
+            ofWorkgroup += states[k].finished;
+            rays += states[k].rays;
+        }
+        finished += ofWorkgroup;
+        if (work.empty()) continue;
+        // Its finished pixels are (but for those in progress) its first runs'.
+        const std::vector<double>& before = progress.costBefore[w];
+        const std::size_t runsDone = std::min<std::size_t>(ofWorkgroup / run, before.size() - 1);
+        double done = before[runsDone];
+        if (runsDone + 1 < before.size()) {
+            const std::uint64_t first = (runsDone * workgroups + w) * run;  // that run's first pixel
+            done += double(ofWorkgroup % run) / double(std::min(run, pixels - first)) *
+                    (before[runsDone + 1] - before[runsDone]);
+        }
+        WorkgroupWork& wg = work[w];
+        wg.done = std::min(done, before.back());
+        wg.total = before.back();
+        costDone += wg.done;
+        if (wg.done > 0.0 && progress.startedAt[w] < 0.0) progress.startedAt[w] = seenAt;
+        if (wg.done >= wg.total && progress.finishedAt[w] < 0.0) progress.finishedAt[w] = seenAt;
+        if (progress.startedAt[w] >= 0.0) {
+            const bool over = progress.finishedAt[w] >= 0.0;
+            wg.secondsRunning = std::max((over ? progress.finishedAt[w] : now) - progress.startedAt[w], 1e-6);
+            if (!over) ++runningNow;
+        }
     }
-    if (request.progress)
-        request.progress((progress.tilesDone + double(finished) / double(tile.width * tile.height)) / plan.count(),
-                         rays);
+    progress.lastReport = now;
+    progress.running = std::max(progress.running, runningNow);
+    double share = double(finished) / double(pixels);
+    if (!work.empty() && finished < pixels) {
+        const double left = scheduleSecondsLeft(work, progress.running);
+        share = left >= 0.0 && now > 0.0 ? now / (now + left) : costDone / progress.tileCost;
+        share = std::min(share, 0.999);
+    }
+    if (request.progress) request.progress((progress.tilesDone + share) / plan.count(), rays);
     if (tileDone) progress.raysBefore = rays;
 }
 
@@ -605,6 +688,7 @@ void ComputeRenderer::dispatchTile(Pipeline& p, const RenderRequest& request, co
                                    gpu::TileParams tile, bool countRays, Progress& progress, GpuRenderResult& result) {
     auto* counters = static_cast<std::uint32_t*>(p.counters.mapped);
     const std::uint32_t groups = std::uint32_t(plan.invocations / SNELL_WORKGROUP_SIZE);
+    if (request.progress) expectTileCost(request, plan, tile, progress);
     progress.whileRunning = [&] {
         if (request.cancel && request.cancel->load())
             std::atomic_ref<std::uint32_t>(counters[SNELL_COUNTER_CANCEL]).store(1u);
@@ -679,6 +763,8 @@ void ComputeRenderer::readBackTile(const Pipeline& p, const RenderRequest& reque
             if (out.truncation.z != 0.0f) ++truncation.overTolerance;
             if (request.boundImage)
                 (*request.boundImage)[std::size_t(windowRow) * area.width() + column + x] = bound;
+            if (request.rayImage)
+                (*request.rayImage)[std::size_t(windowRow) * area.width() + column + x] = out.truncation.w;
         }
     }
     result.readbackMs += msSince(readStart);
@@ -703,6 +789,7 @@ GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool count
 
         const PixelWindow& area = plan.area;
         if (request.boundImage) request.boundImage->assign(std::size_t(area.width()) * area.height(), 0.0f);
+        if (request.rayImage) request.rayImage->assign(std::size_t(area.width()) * area.height(), 0.0f);
         if (!request.rowSink) result.image = Image(area.width(), area.height());
         // Streaming rows: one band of tile rows at a time.
         Image band = request.rowSink ? Image(area.width(), plan.tileHeight) : Image();

@@ -93,6 +93,8 @@ private:
     void readBackTile(const Pipeline& p, const RenderRequest& request, const TilePlan& plan,
                       const gpu::TileParams& tile, Image& rows, int firstRow, Progress& progress,
                       GpuRenderResult& result) const;
+    void expectTileCost(const RenderRequest& request, const TilePlan& plan, const gpu::TileParams& tile,
+                        Progress& progress) const;
     void reportProgress(const Pipeline& p, const RenderRequest& request, const TilePlan& plan,
                         const gpu::TileParams& tile, Progress& progress, bool tileDone) const;
     void submit(Pipeline& p, Progress& progress, bool timed, bool resumes,

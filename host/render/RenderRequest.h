@@ -2,6 +2,7 @@
 // it: the CPU reference (host/reference) or the compute shader (host/gpu).
 #pragma once
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <cstdint>
@@ -97,6 +98,18 @@ struct PixelWindow {
     bool empty() const { return x1 <= x0 || y1 <= y0; }
 };
 
+// What each pixel of an image is expected to cost, on a grid `stride` times
+// coarser than the image (a cell per stride × stride pixels): the progress
+// bar's sparse render.
+struct CostMap {
+    int stride = 1, width = 0, height = 0;
+    std::vector<float> cells;  // row-major, width × height
+    bool empty() const { return cells.empty(); }
+    float at(int x, int y) const {
+        return cells[std::size_t(std::min(y / stride, height - 1)) * width + std::min(x / stride, width - 1)];
+    }
+};
+
 struct RenderRequest {
     Camera camera;
     int width = 0;
@@ -117,6 +130,12 @@ struct RenderRequest {
     // Called now and then (from worker threads) with the fraction of pixels
     // finished and the rays traced so far.
     std::function<void(double fraction, std::uint64_t rays)> progress;
+    // When set (GPU renderer), the fraction given to `progress` counts the
+    // tile in progress by the share of its time done, as the renderer
+    // forecasts it from the expected cost here of the pixels its workgroups
+    // have finished and have left (render/WorkgroupSchedule.h), not by its
+    // pixels finished (cheap ones finish first).
+    const CostMap* expectedCost = nullptr;
     // Set to true from anywhere to stop early (the result is then incomplete).
     const std::atomic<bool>* cancel = nullptr;
     // When set, finished rows go here, top to bottom (width * 3 floats per
@@ -127,6 +146,9 @@ struct RenderRequest {
     TruncationReport* truncation = nullptr;
     // When set, each pixel's truncation bound, row-major (width * height).
     std::vector<float>* boundImage = nullptr;
+    // When set (GPU renderer), each pixel's rays (closest-hit queries of its
+    // trees), row-major (width * height): its cost.
+    std::vector<float>* rayImage = nullptr;
 };
 
 }  // namespace snell
