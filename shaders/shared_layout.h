@@ -278,7 +278,9 @@ struct TileParams {
     uint width;
     uint height;
     uint resume;
-    uint pad0;
+    // Workgroup g takes share (g · workgroupStride) mod W of the tile's W
+    // shares of pixels (trace.comp, takePixel); coprime with W.
+    uint workgroupStride;
     uint pad1;
     uint pad2;
 };

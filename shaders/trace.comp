@@ -397,6 +397,12 @@ float etaOfSphere(uint sphere) { return materialKt(sphereMaterial(sphere)).w; }
 // after another, each invocation's first frontier entry was a page of its own,
 // and on lavapipe faulting those pages in cost 1–2 ms a render.
 uint invocations;  // of this dispatch (main)
+// This workgroup's share of the tile's pixels (takePixel). lavapipe runs
+// each thread's workgroups from one contiguous range of IDs, so with share =
+// ID the threads took the tile's column stripes side by side: a 1024-wide
+// tile with its glass on the left ran on one thread. A stride coprime with
+// the count near count / golden ratio spreads each range over the tile.
+uint share;
 uint stackEntry(uint slot, uint k) { return k * invocations + slot; }
 uint frontierEntry(uint slot, uint k) { return (RAY_STACK + k % max(FRONTIER, 1u)) * invocations + slot; }
 
@@ -769,10 +775,10 @@ void beginStep(inout SlotState state) {
     state.frontierOld = state.frontierCount;
 }
 
-// The invocation's next pixel of the tile. The tile is dealt to the
-// workgroups in runs of a workgroup's size (run r to workgroup r mod W); each
-// invocation starts on its own pixel of its workgroup's first run (pixel =
-// slot), and one that finishes a pixel takes its workgroup's next pixel not
+// The invocation's next pixel of the tile. The tile is dealt in W shares of
+// runs of a workgroup's size (run r to share r mod W), one share a
+// workgroup; each invocation starts on its own pixel of its share's first
+// run, and one that finishes a pixel takes its workgroup's next pixel not
 // yet taken, so while the workgroup has pixels left no lane idles beside a
 // lane whose pixel is expensive (a fixed share each left most lanes of a
 // subgroup waiting on the one with the deep glass tree or the long BVH
@@ -782,7 +788,7 @@ void beginStep(inout SlotState state) {
 uint takePixel() {
     const uint size = uint(SNELL_WORKGROUP_SIZE);
     uint taken = size + atomicAdd(counters[SNELL_COUNTER_COUNT + gl_WorkGroupID.x * SNELL_COUNTER_STRIDE], 1u);
-    return taken / size * invocations + gl_WorkGroupID.x * size + taken % size;
+    return taken / size * invocations + share * size + taken % size;
 }
 
 // The finished pixel written out (render/Truncation.h: its colour, bound and
@@ -846,6 +852,7 @@ bool nextRay(uint slot, inout SlotState state, uvec2 pixel, out Ray ray) {
 // zeroed, and the spheres of a small scene preloaded.
 void beginDispatch() {
     invocations = gl_NumWorkGroups.x * uint(SNELL_WORKGROUP_SIZE);
+    share = gl_WorkGroupID.x * max(tile.workgroupStride, 1u) % gl_NumWorkGroups.x;
     tilePixels = tile.width * tile.height;
     [[unroll]] for (int k = 0; k < SNELL_RAY_COUNTER_COUNT; ++k) countedRays[k] = 0u;
     [[unroll]] for (uint i = 0u; i < SPHERE_COUNT; ++i) {
@@ -954,7 +961,7 @@ void main() {
     // This invocation's progress: its current pixel, that pixel's sum, and the
     // rays on its stack and in its frontier. Fresh, or resumed from the last
     // dispatch.
-    SlotState state = freshPixel(slot);
+    SlotState state = freshPixel(share * uint(SNELL_WORKGROUP_SIZE) + gl_LocalInvocationID.x);
     if (tile.resume != 0u) state = slotStates[slot];
     float cutOff = state.cutOff;
     uint shadowRays = 0u;               // cast in this dispatch (for SlotState.rays)

@@ -1,5 +1,6 @@
 // The time a tile's workgroups have left (render/WorkgroupSchedule), as a
 // device with a few executors runs them: given, not measured, so exact.
+#include <cstdint>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -7,6 +8,7 @@
 #include "render/WorkgroupSchedule.h"
 
 using snell::scheduleSecondsLeft;
+using snell::spreadingStride;
 using snell::WorkgroupWork;
 
 namespace {
@@ -46,6 +48,28 @@ TEST(WorkgroupSchedule, AllAtOnceTheTileEndsWithItsLongestWorkgroup) {
     // A GPU runs every workgroup at once: the tile ends with the one with most left.
     const std::vector<WorkgroupWork> work{{1, 3, 1}, {1, 2, 1}, {1, 5, 1}};
     EXPECT_DOUBLE_EQ(scheduleSecondsLeft(work, 3), 4.0);
+}
+
+TEST(WorkgroupSchedule, NeighbouringWorkgroupsTakeSharesApart) {
+    // Where one thread runs the first half of the workgroups and another the
+    // rest, each takes shares from both halves of the tile (with the share
+    // its own index, the first thread took the left half of a 1024-wide tile).
+    for (std::uint32_t count = 1; count <= 600; ++count) {
+        SCOPED_TRACE(count);
+        const std::uint32_t stride = spreadingStride(count);
+        std::vector<bool> taken(count, false);
+        std::uint32_t firstHalfInLeftHalf = 0;
+        for (std::uint32_t g = 0; g < count; ++g) {
+            const std::uint32_t share = std::uint32_t(std::uint64_t(g) * stride % count);
+            EXPECT_FALSE(taken[share]);
+            taken[share] = true;
+            if (g < count / 2 && 2 * share < count) ++firstHalfInLeftHalf;
+        }
+        if (count >= 8) {
+            EXPECT_GE(4 * firstHalfInLeftHalf, count / 2);
+            EXPECT_LE(4 * firstHalfInLeftHalf, 3 * (count / 2));
+        }
+    }
 }
 
 }  // namespace

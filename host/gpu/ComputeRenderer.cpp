@@ -393,8 +393,12 @@ struct ComputeRenderer::TilePlan {
     PixelWindow area;  // the window rendered; pixel coordinates stay the whole image's
     int tileWidth = 0, tileHeight = 0, tilesX = 0, tilesY = 0;
     VkDeviceSize invocations = 0;
+    std::uint32_t workgroupStride = 1;  // TileParams::workgroupStride
 
     int count() const { return tilesX * tilesY; }
+    std::uint64_t workgroups() const { return invocations / SNELL_WORKGROUP_SIZE; }
+    // The share of the tile's pixels workgroup w takes (trace.comp, takePixel).
+    std::uint64_t shareOf(std::uint64_t w) const { return w * workgroupStride % workgroups(); }
     VkDeviceSize tilePixels() const { return VkDeviceSize(tileWidth) * tileHeight; }
     // Tile (tx, ty): where it is, and how an invocation steps through it.
     gpu::TileParams tile(int tx, int ty) const {
@@ -403,6 +407,7 @@ struct ComputeRenderer::TilePlan {
         t.originY = std::uint32_t(area.y0 + ty * tileHeight);
         t.width = std::uint32_t(std::min(tileWidth, area.width() - tx * tileWidth));
         t.height = std::uint32_t(std::min(tileHeight, area.height() - ty * tileHeight));
+        t.workgroupStride = workgroupStride;
         return t;
     }
 };
@@ -415,8 +420,8 @@ struct ComputeRenderer::Progress {
     int tilesDone = 0;
     TruncationReport truncation;
     // With an expected cost (RenderRequest::expectedCost), of the tile in
-    // progress: each workgroup's expected cost before each of its runs of
-    // pixels, in the order it takes them (trace.comp, takePixel), and the
+    // progress: each share's expected cost before each of its runs of pixels,
+    // in the order a workgroup takes them (trace.comp, takePixel), and the
     // tile's in all.
     std::vector<std::vector<double>> costBefore;
     double tileCost = 0.0;
@@ -456,6 +461,10 @@ ComputeRenderer::TilePlan ComputeRenderer::planTiles(const RenderRequest& reques
     plan.invocations =
         std::clamp<VkDeviceSize>(std::min(slots, plan.tilePixels()) / SNELL_WORKGROUP_SIZE, 1, 65535) *
         SNELL_WORKGROUP_SIZE;
+    // lavapipe gives each thread a contiguous range of workgroups: the shares
+    // of neighbouring workgroups are spread over the tile (trace.comp, share).
+    if (context_.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU)
+        plan.workgroupStride = spreadingStride(std::uint32_t(plan.workgroups()));
     return plan;
 }
 
@@ -597,10 +606,10 @@ void ComputeRenderer::firstDispatch(Pipeline& p) {
 }
 
 // The tile's expected cost in the order its pixels are taken: the tile is
-// dealt to the workgroups in runs of a workgroup's size, run r to workgroup
-// r mod W, and each workgroup takes its runs in order (trace.comp,
-// takePixel), so what a workgroup has finished is, but for the pixels in
-// progress, the start of its runs.
+// dealt in shares of runs of a workgroup's size, run r to share r mod W, and
+// each workgroup takes its share's runs in order (trace.comp, takePixel), so
+// what a workgroup has finished is, but for the pixels in progress, the
+// start of its share.
 void ComputeRenderer::expectTileCost(const RenderRequest& request, const TilePlan& plan,
                                      const gpu::TileParams& tile, Progress& progress) const {
     progress.costBefore.clear();
@@ -609,7 +618,7 @@ void ComputeRenderer::expectTileCost(const RenderRequest& request, const TilePla
     progress.lastReport = 0.0;
     if (!request.expectedCost || request.expectedCost->empty()) return;
     const CostMap& map = *request.expectedCost;
-    const std::uint64_t run = SNELL_WORKGROUP_SIZE, workgroups = plan.invocations / run;
+    const std::uint64_t run = SNELL_WORKGROUP_SIZE, workgroups = plan.workgroups();
     const std::uint64_t pixels = std::uint64_t(tile.width) * tile.height, runs = (pixels + run - 1) / run;
     progress.costBefore.assign(workgroups, std::vector<double>(1, 0.0));
     for (std::uint64_t r = 0; r < runs; ++r) {
@@ -632,7 +641,7 @@ void ComputeRenderer::expectTileCost(const RenderRequest& request, const TilePla
 void ComputeRenderer::reportProgress(const Pipeline& p, const RenderRequest& request, const TilePlan& plan,
                                      const gpu::TileParams& tile, Progress& progress, bool tileDone) const {
     const auto* states = static_cast<const gpu::SlotState*>(p.slotStates.mapped);
-    const std::uint64_t run = SNELL_WORKGROUP_SIZE, workgroups = plan.invocations / run;
+    const std::uint64_t run = SNELL_WORKGROUP_SIZE, workgroups = plan.workgroups();
     const std::uint64_t pixels = std::uint64_t(tile.width) * tile.height;
     const double now = std::chrono::duration<double>(Clock::now() - progress.tileStart).count();
     const double seenAt = 0.5 * (progress.lastReport + now);  // between the last report and this one
@@ -648,12 +657,13 @@ void ComputeRenderer::reportProgress(const Pipeline& p, const RenderRequest& req
         }
         finished += ofWorkgroup;
         if (work.empty()) continue;
-        // Its finished pixels are (but for those in progress) its first runs'.
-        const std::vector<double>& before = progress.costBefore[w];
+        // Its finished pixels are (but for those in progress) its share's first runs'.
+        const std::uint64_t share = plan.shareOf(w);
+        const std::vector<double>& before = progress.costBefore[share];
         const std::size_t runsDone = std::min<std::size_t>(ofWorkgroup / run, before.size() - 1);
         double done = before[runsDone];
         if (runsDone + 1 < before.size()) {
-            const std::uint64_t first = (runsDone * workgroups + w) * run;  // that run's first pixel
+            const std::uint64_t first = (runsDone * workgroups + share) * run;  // that run's first pixel
             done += double(ofWorkgroup % run) / double(std::min(run, pixels - first)) *
                     (before[runsDone + 1] - before[runsDone]);
         }

@@ -1,7 +1,9 @@
 #include "render/WorkgroupSchedule.h"
 
 #include <algorithm>
+#include <cmath>
 #include <functional>
+#include <numeric>
 #include <queue>
 
 namespace snell {
@@ -33,6 +35,14 @@ double scheduleSecondsLeft(const std::vector<WorkgroupWork>& workgroups, std::si
         freeAt.pop();
     }
     return end;
+}
+
+std::uint32_t spreadingStride(std::uint32_t count) {
+    const auto near = std::uint32_t(std::lround(double(count) / 1.6180339887498949));
+    for (std::uint32_t d = 0; d <= count; ++d)
+        for (const std::uint32_t k : {near + d, near - d})
+            if (k >= 1 && k <= count && std::gcd(k, count) == 1) return k;
+    return 1;
 }
 
 }  // namespace snell

@@ -1,4 +1,5 @@
-// How long a tile in progress has left, from how its workgroups run. The
+// How the workgroups of a tile run, for the compute renderer: which share of
+// the tile each takes, and how long a tile in progress has left. The
 // compute renderer deals each workgroup its own pixels (trace.comp,
 // takePixel), and a device runs a few workgroups at once, each to its end:
 // lavapipe one a thread, in order. So the tile ends when its last workgroup
@@ -8,6 +9,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 namespace snell {
@@ -26,5 +28,13 @@ struct WorkgroupWork {
 // at the pace the running and finished ones have shown (their cost done over
 // their seconds running). Negative where no workgroup has shown a pace yet.
 double scheduleSecondsLeft(const std::vector<WorkgroupWork>& workgroups, std::size_t executors);
+
+// lavapipe gives each thread a contiguous range of workgroup IDs, so the
+// shares of the tile that neighbouring workgroups take should lie apart:
+// workgroup g takes share g · stride mod count (trace.comp, takePixel). The
+// stride nearest count / golden ratio that is coprime with count makes that
+// a permutation in which any range of workgroups takes shares spread over
+// the whole tile.
+std::uint32_t spreadingStride(std::uint32_t count);
 
 }  // namespace snell
