@@ -309,6 +309,13 @@ uint closestHit(rvec3 origin, rvec3 dir, uint fromSphere, uint start, out real t
 // Stops at the first occluder.
 bool occluded(rvec3 origin, rvec3 dir, real distance, uint fromSphere, uint start) {
     real originLength = length(origin);
+    // A ray that starts on a sphere headed into it (shading a hit from inside)
+    // crosses that sphere at its chord unless the light is nearer: that one
+    // test first spares the search its answer. (Not where the spheres are
+    // unrolled: a dynamic index into them costs more than it spares.)
+    if ((USE_BVH || SPHERE_COUNT == 0u) && start == ENTERING &&
+        intersectSphere(fromSphere, origin, originLength, dir, fromSphere, start) < distance)
+        return true;
     if (USE_BVH) return searchBvh(origin, originLength, dir, fromSphere, start, true, distance) != NONE;
     bool blocked = false;
     if (SPHERE_COUNT > 0u) {

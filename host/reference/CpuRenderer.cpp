@@ -207,6 +207,10 @@ bool CpuRenderer::closestHit(const Ray& ray, std::uint32_t fromSphere, StartsOn 
 
 bool CpuRenderer::occluded(const Ray& ray, double distance, std::uint32_t fromSphere, StartsOn start) const {
     // SPEC §4.3: blocked if a surface crosses the open segment (0, distance).
+    // A ray that starts on a sphere headed into it (shading a hit from inside)
+    // crosses that sphere at its chord unless the light is nearer: that one
+    // test first spares the search its answer.
+    if (start == StartsOn::Entering && intersect(fromSphere, ray, fromSphere, start) < distance) return true;
     if (!useBvh_) {
         for (std::uint32_t i = 0; i < scene_.spheres.size(); ++i)
             if (intersect(i, ray, fromSphere, start) < distance) return true;
