@@ -410,6 +410,7 @@ uint invocations;  // of this dispatch (main)
 // tile with its glass on the left ran on one thread. A stride coprime with
 // the count near count / golden ratio spreads each range over the tile.
 uint share;
+uint helpedShare;  // the share the invocation takes its pixels from (takePixel)
 uint stackEntry(uint slot, uint k) { return k * invocations + slot; }
 uint frontierEntry(uint slot, uint k) { return (RAY_STACK + k % max(FRONTIER, 1u)) * invocations + slot; }
 
@@ -784,18 +785,33 @@ void beginStep(inout SlotState state) {
 
 // The invocation's next pixel of the tile. The tile is dealt in W shares of
 // runs of a workgroup's size (run r to share r mod W), one share a
-// workgroup; each invocation starts on its own pixel of its share's first
-// run, and one that finishes a pixel takes its workgroup's next pixel not
-// yet taken, so while the workgroup has pixels left no lane idles beside a
-// lane whose pixel is expensive (a fixed share each left most lanes of a
-// subgroup waiting on the one with the deep glass tree or the long BVH
-// walks). A counter per workgroup, on a cache line of its own: one counter
-// for the whole tile moved between the cores at every pixel, which cost
-// more than it won on cheap scenes (bench/simple, 2 threads).
-uint takePixel() {
+// workgroup, each with its counter of pixels taken, on a cache line of its
+// own (one counter for the whole tile moved between the cores at every
+// pixel, which cost more than it won on cheap scenes). An invocation takes
+// the next pixel of its workgroup's share not yet taken, so while the share
+// has pixels left no lane idles beside a lane whose pixel is expensive (a
+// fixed share each left most lanes of a subgroup waiting on the one with the
+// deep glass tree or the long BVH walks). Where trees diverge (refraction, a
+// BVH) an invocation whose share is taken helps with the other workgroups'
+// in turn, so no lane and no core idles while any share has pixels left:
+// the end of each share no longer leaves its lanes idle, nor the end of the
+// tile a core. (lavapipe runs a workgroup to its end on one thread: a
+// workgroup goes on through the shares of those queued behind it, which
+// then find them taken.) Elsewhere it stops: on gonzalez-originalTest,
+// cheap and even, helping cost 15–25 % (docs/performance.md).
+const bool HELPS = HAS_REFRACTION || USE_BVH;
+uint takeFromHelpedShare() {
     const uint size = uint(SNELL_WORKGROUP_SIZE);
-    uint taken = size + atomicAdd(counters[SNELL_COUNTER_COUNT + gl_WorkGroupID.x * SNELL_COUNTER_STRIDE], 1u);
-    return taken / size * invocations + share * size + taken % size;
+    uint taken = atomicAdd(counters[SNELL_COUNTER_COUNT + helpedShare * SNELL_COUNTER_STRIDE], 1u);
+    return taken / size * invocations + helpedShare * size + taken % size;
+}
+uint takePixel() {
+    uint pixel = takeFromHelpedShare();
+    for (uint k = 1u; k < (HELPS ? gl_NumWorkGroups.x : 1u) && pixel >= tilePixels; ++k) {
+        helpedShare = helpedShare + 1u == gl_NumWorkGroups.x ? 0u : helpedShare + 1u;
+        pixel = takeFromHelpedShare();
+    }
+    return min(pixel, tilePixels);
 }
 
 // The finished pixel written out (render/Truncation.h: its colour, bound and
@@ -860,6 +876,7 @@ bool nextRay(uint slot, inout SlotState state, uvec2 pixel, out Ray ray) {
 void beginDispatch() {
     invocations = gl_NumWorkGroups.x * uint(SNELL_WORKGROUP_SIZE);
     share = gl_WorkGroupID.x * max(tile.workgroupStride, 1u) % gl_NumWorkGroups.x;
+    helpedShare = share;
     tilePixels = tile.width * tile.height;
     [[unroll]] for (int k = 0; k < SNELL_RAY_COUNTER_COUNT; ++k) countedRays[k] = 0u;
     [[unroll]] for (uint i = 0u; i < SPHERE_COUNT; ++i) {
@@ -968,8 +985,7 @@ void main() {
     // This invocation's progress: its current pixel, that pixel's sum, and the
     // rays on its stack and in its frontier. Fresh, or resumed from the last
     // dispatch.
-    SlotState state = freshPixel(share * uint(SNELL_WORKGROUP_SIZE) + gl_LocalInvocationID.x);
-    if (tile.resume != 0u) state = slotStates[slot];
+    SlotState state = tile.resume != 0u ? slotStates[slot] : freshPixel(takePixel());
     float cutOff = state.cutOff;
     uint shadowRays = 0u;               // cast in this dispatch (for SlotState.rays)
     uint deepest = 0u;

@@ -394,6 +394,9 @@ struct ComputeRenderer::TilePlan {
     int tileWidth = 0, tileHeight = 0, tilesX = 0, tilesY = 0;
     VkDeviceSize invocations = 0;
     std::uint32_t workgroupStride = 1;  // TileParams::workgroupStride
+    // Whether workgroups help with each other's shares once theirs is taken
+    // (trace.comp, HELPS): then what a workgroup finished is not its share's.
+    bool helps = false;
 
     int count() const { return tilesX * tilesY; }
     std::uint64_t workgroups() const { return invocations / SNELL_WORKGROUP_SIZE; }
@@ -424,6 +427,7 @@ struct ComputeRenderer::Progress {
     // in the order a workgroup takes them (trace.comp, takePixel), and the
     // tile's in all.
     std::vector<std::vector<double>> costBefore;
+    std::vector<std::uint64_t> sharePixels;  // each share's pixels
     double tileCost = 0.0;
     // When the tile started, and when each workgroup was first seen running
     // and seen finished (seconds into the tile; negative: not yet); the most
@@ -465,6 +469,7 @@ ComputeRenderer::TilePlan ComputeRenderer::planTiles(const RenderRequest& reques
     // of neighbouring workgroups are spread over the tile (trace.comp, share).
     if (context_.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU)
         plan.workgroupStride = spreadingStride(std::uint32_t(plan.workgroups()));
+    plan.helps = values[SNELL_SPEC_HAS_REFRACTION] != 0 || values[SNELL_SPEC_USE_BVH] != 0;
     return plan;
 }
 
@@ -621,12 +626,14 @@ void ComputeRenderer::expectTileCost(const RenderRequest& request, const TilePla
     const std::uint64_t run = SNELL_WORKGROUP_SIZE, workgroups = plan.workgroups();
     const std::uint64_t pixels = std::uint64_t(tile.width) * tile.height, runs = (pixels + run - 1) / run;
     progress.costBefore.assign(workgroups, std::vector<double>(1, 0.0));
+    progress.sharePixels.assign(workgroups, 0);
     for (std::uint64_t r = 0; r < runs; ++r) {
         double cost = 0.0;
         for (std::uint64_t k = r * run; k < std::min(pixels, (r + 1) * run); ++k)
             cost += map.at(int(tile.originX + k % tile.width), int(tile.originY + k / tile.width));
         std::vector<double>& before = progress.costBefore[r % workgroups];
         before.push_back(before.back() + cost);
+        progress.sharePixels[r % workgroups] += std::min(run, pixels - r * run);
         progress.tileCost += cost;
     }
     progress.startedAt.assign(workgroups, -1.0);
@@ -635,7 +642,8 @@ void ComputeRenderer::expectTileCost(const RenderRequest& request, const TilePla
 
 // The request's progress callback: finished tiles plus the share of the
 // current tile done, and the rays so far. The share is of the tile's pixels
-// finished, or with an expected cost, of its time: the time so far against
+// finished, or with an expected cost, of its time: where workgroups help
+// with each other's shares, the cost done; else the time so far against
 // that and the time its workgroups have left (WorkgroupSchedule), once they
 // have shown their pace.
 void ComputeRenderer::reportProgress(const Pipeline& p, const RenderRequest& request, const TilePlan& plan,
@@ -648,7 +656,19 @@ void ComputeRenderer::reportProgress(const Pipeline& p, const RenderRequest& req
     std::uint64_t finished = 0, rays = progress.raysBefore;
     double costDone = 0.0;
     std::size_t runningNow = 0;
-    std::vector<WorkgroupWork> work(progress.tileCost > 0.0 ? workgroups : 0);
+    // The expected cost of a share's first `count` pixels (the order it is taken in).
+    auto costOfFirst = [&](std::uint64_t share, std::uint64_t count) {
+        const std::vector<double>& before = progress.costBefore[share];
+        const std::size_t runsDone = std::min<std::size_t>(count / run, before.size() - 1);
+        double done = before[runsDone];
+        if (runsDone + 1 < before.size()) {
+            const std::uint64_t first = (runsDone * workgroups + share) * run;  // that run's first pixel
+            done += double(count % run) / double(std::min(run, pixels - first)) *
+                    (before[runsDone + 1] - before[runsDone]);
+        }
+        return std::min(done, before.back());
+    };
+    std::vector<WorkgroupWork> work(progress.tileCost > 0.0 && !plan.helps ? workgroups : 0);
     for (std::uint64_t w = 0; w < workgroups; ++w) {
         std::uint64_t ofWorkgroup = 0;
         for (std::uint64_t k = w * run; k < (w + 1) * run; ++k) {
@@ -659,17 +679,9 @@ void ComputeRenderer::reportProgress(const Pipeline& p, const RenderRequest& req
         if (work.empty()) continue;
         // Its finished pixels are (but for those in progress) its share's first runs'.
         const std::uint64_t share = plan.shareOf(w);
-        const std::vector<double>& before = progress.costBefore[share];
-        const std::size_t runsDone = std::min<std::size_t>(ofWorkgroup / run, before.size() - 1);
-        double done = before[runsDone];
-        if (runsDone + 1 < before.size()) {
-            const std::uint64_t first = (runsDone * workgroups + share) * run;  // that run's first pixel
-            done += double(ofWorkgroup % run) / double(std::min(run, pixels - first)) *
-                    (before[runsDone + 1] - before[runsDone]);
-        }
         WorkgroupWork& wg = work[w];
-        wg.done = std::min(done, before.back());
-        wg.total = before.back();
+        wg.done = costOfFirst(share, ofWorkgroup);
+        wg.total = progress.costBefore[share].back();
         costDone += wg.done;
         if (wg.done > 0.0 && progress.startedAt[w] < 0.0) progress.startedAt[w] = seenAt;
         if (wg.done >= wg.total && progress.finishedAt[w] < 0.0) progress.finishedAt[w] = seenAt;
@@ -682,7 +694,21 @@ void ComputeRenderer::reportProgress(const Pipeline& p, const RenderRequest& req
     progress.lastReport = now;
     progress.running = std::max(progress.running, runningNow);
     double share = double(finished) / double(pixels);
-    if (!work.empty() && finished < pixels) {
+    if (plan.helps && progress.tileCost > 0.0 && finished < pixels) {
+        // Every workgroup works on while any share has pixels left, so the
+        // tile's time goes with its cost: the cost of the pixels taken (each
+        // share's counter), less those still in flight at the average cost.
+        const auto* counters = static_cast<const std::uint32_t*>(p.counters.mapped);
+        double costTaken = 0.0;
+        std::uint64_t taken = 0;
+        for (std::uint64_t s = 0; s < workgroups; ++s) {
+            const std::uint64_t t =
+                std::min<std::uint64_t>(counters[SNELL_COUNTER_COUNT + s * SNELL_COUNTER_STRIDE], progress.sharePixels[s]);
+            costTaken += costOfFirst(s, t);
+            taken += t;
+        }
+        if (taken > 0) share = std::min(0.999, costTaken * std::min(1.0, double(finished) / double(taken)) / progress.tileCost);
+    } else if (!work.empty() && finished < pixels) {
         const double left = scheduleSecondsLeft(work, progress.running);
         share = left >= 0.0 && now > 0.0 ? now / (now + left) : costDone / progress.tileCost;
         share = std::min(share, 0.999);
