@@ -376,8 +376,8 @@ namespace {
 // rays (its closest-hit queries: the rays the progress reports, but for the
 // shadow rays), and with an expected cost the share of each tile done, which
 // never changes the image.
-TEST(GpuProgress, PixelRaysAndSharesOfTheTile) {
-    const snell::Scene scene = snell::parseSceneFile(SNELL_SOURCE_DIR "/scenes/glass.scn");
+void checkPixelRaysAndShares(const std::string& scenePath) {
+    const snell::Scene scene = snell::parseSceneFile(scenePath);
     snell::RenderRequest request;
     request.width = request.height = 48;
     request.camera = snell::Camera::fromSpec(48, scene.halfWidth);
@@ -412,6 +412,16 @@ TEST(GpuProgress, PixelRaysAndSharesOfTheTile) {
     }
     EXPECT_EQ(shares.back(), 1.0);
     EXPECT_EQ(weighed.image.rgb, counted.image.rgb);
+}
+
+// Refraction: workgroups help with each other's shares (trace.comp,
+// takePixel), and the tile's progress is its cost done.
+TEST(GpuProgress, PixelRaysAndSharesOfTheTile) { checkPixelRaysAndShares(SNELL_SOURCE_DIR "/scenes/glass.scn"); }
+
+// Neither refraction nor a BVH: each workgroup keeps to its share, and the
+// tile's progress comes from its workgroups' schedule.
+TEST(GpuProgress, PixelRaysAndSharesOfATileOfOwnShares) {
+    checkPixelRaysAndShares(SNELL_SOURCE_DIR "/scenes/mirrors.scn");
 }
 
 }  // namespace
