@@ -985,7 +985,9 @@ void main() {
     // This invocation's progress: its current pixel, that pixel's sum, and the
     // rays on its stack and in its frontier. Fresh, or resumed from the last
     // dispatch.
-    SlotState state = tile.resume != 0u ? slotStates[slot] : freshPixel(takePixel());
+    SlotState state;
+    if (tile.resume != 0u) state = slotStates[slot];
+    else state = freshPixel(takePixel());
     float cutOff = state.cutOff;
     uint shadowRays = 0u;               // cast in this dispatch (for SlotState.rays)
     uint deepest = 0u;
