@@ -798,7 +798,7 @@ void beginStep(inout SlotState state) {
 // tile a core. (lavapipe runs a workgroup to its end on one thread: a
 // workgroup goes on through the shares of those queued behind it, which
 // then find them taken.) Elsewhere it stops: on gonzalez-originalTest,
-// cheap and even, helping cost 15–25 % (docs/performance.md).
+// cheap and even, helping cost 15–21 % (docs/performance.md).
 const bool HELPS = HAS_REFRACTION || USE_BVH;
 uint takeFromHelpedShare() {
     const uint size = uint(SNELL_WORKGROUP_SIZE);
