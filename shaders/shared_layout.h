@@ -84,7 +84,8 @@ using uint = std::uint32_t;
 #define SNELL_SPEC_FRONTIER 15
 #define SNELL_SPEC_COUNT_LANES 16  // count the SIMD lanes busy in each loop pass (render --count-lanes)
 #define SNELL_SPEC_TRAPS 17        // some material traps light (render/Truncation.h, growthTraps)
-#define SNELL_SPEC_COUNT 18
+#define SNELL_SPEC_HELPS 18        // workgroups help with each other's shares of a tile (trace.comp, takePixel)
+#define SNELL_SPEC_COUNT 19
 
 // Slots of the counters buffer: rays by kind, then per-dispatch bookkeeping.
 #define SNELL_COUNTER_PRIMARY 0

@@ -798,8 +798,9 @@ void beginStep(inout SlotState state) {
 // tile a core. (lavapipe runs a workgroup to its end on one thread: a
 // workgroup goes on through the shares of those queued behind it, which
 // then find them taken.) Elsewhere it stops: on gonzalez-originalTest,
-// cheap and even, helping cost 15–21 % (docs/performance.md).
-const bool HELPS = HAS_REFRACTION || USE_BVH;
+// cheap and even, helping cost 15–21 % (docs/performance.md). The host
+// decides (ComputeRenderer::specialise) and reads the tile's progress by it.
+layout(constant_id = SNELL_SPEC_HELPS) const bool HELPS = false;
 uint takeFromHelpedShare() {
     const uint size = uint(SNELL_WORKGROUP_SIZE);
     uint taken = atomicAdd(counters[SNELL_COUNTER_COUNT + helpedShare * SNELL_COUNTER_STRIDE], 1u);

@@ -227,6 +227,10 @@ ComputeRenderer::Specialisation ComputeRenderer::specialise(const RenderRequest&
         hasRefraction ? rayStackEntries(scene_, request.trace, hasReflection) + 1 : 1;  // + the suspended ray
     values[SNELL_SPEC_AMPLIFYING] = layout_.amplifying;
     values[SNELL_SPEC_TRAPS] = layout_.traps;
+    // Where ray trees diverge (refraction, a BVH) a workgroup whose share of
+    // the tile is taken helps with the others' (trace.comp, takePixel); on
+    // cheap, even scenes that cost more than it won (docs/performance.md).
+    values[SNELL_SPEC_HELPS] = hasRefraction || layout_.usesBvh();
     // Under a tolerance, a frontier for the rays a step leaves under its
     // cut-off; where it is full, rays are traced down to the floor instead.
     const bool secondaryRays = hasRefraction || hasReflection;
@@ -395,7 +399,7 @@ struct ComputeRenderer::TilePlan {
     VkDeviceSize invocations = 0;
     std::uint32_t workgroupStride = 1;  // TileParams::workgroupStride
     // Whether workgroups help with each other's shares once theirs is taken
-    // (trace.comp, HELPS): then what a workgroup finished is not its share's.
+    // (SNELL_SPEC_HELPS): then what a workgroup finished is not its share's.
     bool helps = false;
 
     int count() const { return tilesX * tilesY; }
@@ -469,7 +473,7 @@ ComputeRenderer::TilePlan ComputeRenderer::planTiles(const RenderRequest& reques
     // of neighbouring workgroups are spread over the tile (trace.comp, share).
     if (context_.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU)
         plan.workgroupStride = spreadingStride(std::uint32_t(plan.workgroups()));
-    plan.helps = values[SNELL_SPEC_HAS_REFRACTION] != 0 || values[SNELL_SPEC_USE_BVH] != 0;
+    plan.helps = values[SNELL_SPEC_HELPS] != 0;
     return plan;
 }
 
