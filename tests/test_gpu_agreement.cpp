@@ -374,7 +374,7 @@ namespace {
 
 // What the progress bar's estimate takes from the renderer: each pixel's
 // rays (its closest-hit queries: the rays the progress reports, but for the
-// shadow rays), and with an expected cost the share of each tile done, which
+// shadow rays), the render's rays in all, and with an expected cost the share of each tile done, which
 // never changes the image.
 void checkPixelRaysAndShares(const std::string& scenePath) {
     const snell::Scene scene = snell::parseSceneFile(scenePath);
@@ -395,6 +395,10 @@ void checkPixelRaysAndShares(const std::string& scenePath) {
         sum += r;
     }
     EXPECT_EQ(sum + double(counted.rays.shadow), double(reportedRays));
+    // The render's total of them, the progress bar's probe's cost, needs no
+    // counting build (so the probe compiles the render's own pipeline).
+    EXPECT_EQ(counted.tracedRays, reportedRays);
+    EXPECT_EQ(gpu.render(request, false).tracedRays, reportedRays);
 
     // The cost map, one cell per 4 × 4 pixels, from those rays.
     snell::CostMap cost{4, 12, 12, std::vector<float>(12 * 12, 0.0f)};

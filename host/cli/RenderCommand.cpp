@@ -394,14 +394,17 @@ RenderOutcome RenderCommand::renderOnGpu(const Scene& scene, RenderRequest& requ
                                  o_.device.search());
         if (const std::uint32_t budget = loopBudgetOverride()) renderer.forceLoopBudget(budget);
         renderer.countLanes(o_.countLanes);
-        // The probe compiles the pipeline (the same one: same settings), which belongs to pipelineMs.
+        // The probe compiles the pipeline, which belongs to pipelineMs: the
+        // render's own (the same specialisation, counting rays only as the
+        // render does), so the render reuses it rather than compiling a second
+        // one (seconds on a cold shader cache) inside the time the bar counts.
         CostMap expectedCost;
         if (progress.enabled())
             estimateCost(scene, request, ComputeRenderer::tiles(request.area()), progress, r,
                          [&](const RenderRequest& probe) {
-                             const GpuRenderResult g = renderer.render(probe, true);
+                             const GpuRenderResult g = renderer.render(probe, o_.stats);
                              r.pipelineMs += g.pipelineMs;
-                             return std::pair(g.renderMs, double(g.rays.total()));
+                             return std::pair(g.renderMs, double(g.tracedRays));
                          },
                          &expectedCost);
         if (!expectedCost.empty()) request.expectedCost = &expectedCost;

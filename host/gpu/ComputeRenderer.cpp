@@ -845,6 +845,7 @@ GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool count
             if (request.rowSink) request.rowSink(band.rgb.data(), std::min(plan.tileHeight, area.height() - bandRow));
         }
         if (request.truncation) *request.truncation = progress.truncation;
+        result.tracedRays = progress.raysBefore;
         result.rayStack = values[SNELL_SPEC_RAY_STACK];
         result.gpuTimed = p.queries != VK_NULL_HANDLE;
         result.renderMs = result.gpuTimed ? progress.gpuMs : progress.hostMs;

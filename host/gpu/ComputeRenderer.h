@@ -19,6 +19,7 @@ namespace snell {
 struct GpuRenderResult {
     Image image;
     RayCounts rays;           // filled when counting was asked for
+    std::uint64_t tracedRays = 0;  // all rays traced, as the invocations report them for progress (always)
     double renderMs = 0.0;    // the dispatches alone
     bool gpuTimed = false;    // renderMs from GPU timestamps (else host timing)
     double pipelineMs = 0.0;  // shader pipeline creation
