@@ -372,10 +372,10 @@ TEST(GpuResume, SuspendingNeverChangesTheImage) {
 
 namespace {
 
-// What the progress bar's estimate takes from the renderer: each pixel's
-// rays (its closest-hit queries: the rays the progress reports, but for the
-// shadow rays), the render's rays in all, and with an expected cost the share of each tile done, which
-// never changes the image.
+// What the progress bar's estimate takes from the renderer: each pixel's rays
+// (its closest-hit queries: the rays the progress reports, but for the shadow
+// rays), the render's rays in all, and with an expected cost the share of each
+// tile done, which never changes the image.
 void checkPixelRaysAndShares(const std::string& scenePath) {
     const snell::Scene scene = snell::parseSceneFile(scenePath);
     snell::RenderRequest request;
