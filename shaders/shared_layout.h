@@ -172,17 +172,27 @@ struct Light {
     vec4 colour;    // rgb, w unused
 };
 
-// A BVH node (read as RGBA32UI: the corners are float bits). Nodes are in
-// depth-first order: an inner node's first child is the next node, its second
-// child the first child's `skip`, the node after the first child's subtree.
-// A leaf's code is first · 4 + count − 1 for spheres [first, first + count),
-// count ≤ SNELL_BVH_MAX_LEAF; an inner node's code is SNELL_BVH_INNER.
+// A BVH node of up to four children (read as RGBA32UI, SNELL_BVH_NODE_TEXELS
+// texels a node): their boxes axis by axis, lane k of each corner being child
+// k's, so one ray tests all four with vector arithmetic; then their codes
+// (uint bits). A child is a node's index, SNELL_BVH_LEAF | first · 4 +
+// count − 1 for the leaf of spheres [first, first + count), count ≤
+// SNELL_BVH_MAX_LEAF, or SNELL_BVH_EMPTY. Node 0 is the root; nodes are in
+// depth-first order, so a node's first child tends to follow it.
 struct BvhNode {
-    vec4 lower;  // xyz: box corner, w: the bits of skip
-    vec4 upper;  // xyz: box corner, w: the bits of the leaf code
+    vec4 lowerX;
+    vec4 upperX;
+    vec4 lowerY;
+    vec4 upperY;
+    vec4 lowerZ;
+    vec4 upperZ;
+    vec4 child;  // uint bits
 };
+#define SNELL_BVH_NODE_TEXELS 7
+#define SNELL_BVH_WIDTH 4
 #define SNELL_BVH_MAX_LEAF 4
-#define SNELL_BVH_INNER 0xffffffffu
+#define SNELL_BVH_LEAF 0x80000000u
+#define SNELL_BVH_EMPTY 0xffffffffu
 
 // An invocation's progress between dispatches (one per invocation). A pixel
 // is traced in steps of falling cut-off: a step traces on from the rays the

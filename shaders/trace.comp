@@ -161,50 +161,46 @@ real intersectSphere(uint index, rvec3 origin, real originLength, rvec3 dir, uin
     return intersectTrueSphere(anchor, normal, origin, originLength, dir, mode);
 }
 
-// Slab test against a node's box (stored rounded outwards) within [0, tMax]:
-// whether the ray meets it, and where it enters it.
-bool hitsBox(rvec4 lower, rvec4 upper, rvec3 origin, rvec3 inverseDir, real tMax, out real enter) {
-    rvec3 t0 = (lower.xyz - origin) * inverseDir;
-    rvec3 t1 = (upper.xyz - origin) * inverseDir;
-    rvec3 tNear = min(t0, t1);
-    rvec3 tFar = max(t0, t1);
-    enter = max(max(tNear.x, tNear.y), max(tNear.z, 0.0));
-    // Ize, "Robust BVH Ray Traversal" (JCGT 2013): widen the exit distance so
-    // rounding never culls a box the ray touches.
-    real leave = min(min(tFar.x, tFar.y), min(tFar.z, tMax)) * (1.0 + 8.0 * UNIT_ROUNDOFF);
-    return enter <= leave;
-}
-
 rvec3 safeInverse(rvec3 d) {
     const real tiny = 1e-30;
     return 1.0 / mix(d, rvec3(tiny) * sign(d + rvec3(1e-38)), lessThan(abs(d), rvec3(tiny)));
 }
 
-// A BVH node's box corner (texel 2n: lower, 2n + 1: upper); w is not a float.
-rvec4 nodeCorner(uint texel) { return rvec4(uintBitsToFloat(texelFetch(bvhTexels, int(texel)))); }
+// Lane k of a node's vector is child k's (shared_layout.h: BvhNode).
+rvec4 nodeVector(int texel) { return rvec4(uintBitsToFloat(texelFetch(bvhTexels, texel))); }
 
-// The BVH walk shared by the closest hit and the visibility test: nodes in
-// depth-first order (shared_layout.h), an inner node's children n + 1 and the
-// skip link of n + 1. Both children's boxes are tested at the parent and the
-// nearer is entered first, the other waiting on a short per-ray stack (at most
-// BVH_DEPTH entries): the closest hit is found early and then culls the rest.
+// Sorts two (entry distance, child) pairs by distance.
+void orderPair(inout real enterA, inout uint childA, inout real enterB, inout uint childB) {
+    bool swap = enterB < enterA;
+    real e = enterA;
+    uint c = childA;
+    enterA = swap ? enterB : enterA;
+    childA = swap ? childB : childA;
+    enterB = swap ? e : enterB;
+    childB = swap ? c : childB;
+}
+
+// The BVH walk shared by the closest hit and the visibility test. A node's
+// four children's boxes are tested at once (a slab test a vector lane each);
+// those the ray enters are taken nearest first, the others waiting on
+// a short per-ray stack (at most (width − 1) · depth entries): the closest
+// hit is found early and then culls the rest. A leaf is entered from the
+// stack or its parent without a fetch of its own: its code says which
+// spheres it holds.
 // anyHit: stop at the first hit before tMax (SPEC §4.3 visibility).
 uint bvhStack[BVH_DEPTH];
 uint traverseBvh(rvec3 origin, real originLength, rvec3 dir, uint fromSphere, uint start, bool anyHit,
                  inout real tHit) {
     rvec3 inverseDir = safeInverse(dir);
     uint hit = NONE;
-    real enter;
-    uvec4 rootUpper = texelFetch(bvhTexels, 1);
-    if (!hitsBox(nodeCorner(0u), rvec4(uintBitsToFloat(rootUpper)), origin, inverseDir, tHit, enter)) return NONE;
-    uint node = 0u;
-    uint code = rootUpper.w;  // the node's leaf code, read with its box
-    uint depth = 0u;          // entries on the stack
+    uint entry = 0u;  // in hand: a node's index, or SNELL_BVH_LEAF | a leaf's code
+    uint depth = 0u;  // entries on the stack
     while (true) {
         tick(1u);
         if (COUNT_LANES) countLanes(true, walkSlots, walkBusy);
-        if (code != SNELL_BVH_INNER) {
+        if ((entry & SNELL_BVH_LEAF) != 0u) {
             // A leaf: spheres first · 4 + count − 1 = code.
+            uint code = entry & ~SNELL_BVH_LEAF;
             uint first = code >> 2;
             uint last = first + (code & 3u);
             [[unroll]] for (uint k = 0u; k < SNELL_BVH_MAX_LEAF; ++k) {
@@ -215,32 +211,42 @@ uint traverseBvh(rvec3 origin, real originLength, rvec3 dir, uint fromSphere, ui
                 }
             }
             if ((anyHit && hit != NONE) || depth == 0u) break;
-            node = bvhStack[--depth];
-            code = texelFetch(bvhTexels, int(2u * node + 1u)).w;
+            entry = bvhStack[--depth];
             continue;
         }
-        uint near = node + 1u;
-        uvec4 nearLower = texelFetch(bvhTexels, int(2u * near));
-        uvec4 nearUpper = texelFetch(bvhTexels, int(2u * near + 1u));
-        uint far = nearLower.w;
-        uvec4 farUpper = texelFetch(bvhTexels, int(2u * far + 1u));
-        real enterNear, enterFar;
-        bool hitsNear = hitsBox(rvec4(uintBitsToFloat(nearLower)), rvec4(uintBitsToFloat(nearUpper)), origin,
-                                inverseDir, tHit, enterNear);
-        bool hitsFar = hitsBox(nodeCorner(2u * far), rvec4(uintBitsToFloat(farUpper)), origin, inverseDir, tHit,
-                               enterFar);
-        if (hitsNear && hitsFar) {
-            bool farFirst = enterFar < enterNear;
-            bvhStack[depth++] = farFirst ? near : far;
-            node = farFirst ? far : near;
-            code = farFirst ? farUpper.w : nearUpper.w;
-        } else if (hitsNear || hitsFar) {
-            node = hitsNear ? near : far;
-            code = hitsNear ? nearUpper.w : farUpper.w;
+        int base = int(entry) * SNELL_BVH_NODE_TEXELS;
+        rvec4 x0 = (nodeVector(base) - origin.x) * inverseDir.x;
+        rvec4 x1 = (nodeVector(base + 1) - origin.x) * inverseDir.x;
+        rvec4 y0 = (nodeVector(base + 2) - origin.y) * inverseDir.y;
+        rvec4 y1 = (nodeVector(base + 3) - origin.y) * inverseDir.y;
+        rvec4 z0 = (nodeVector(base + 4) - origin.z) * inverseDir.z;
+        rvec4 z1 = (nodeVector(base + 5) - origin.z) * inverseDir.z;
+        uvec4 child = texelFetch(bvhTexels, base + 6);
+        // The slab test within [0, tHit] against boxes stored rounded outwards;
+        // Ize, "Robust BVH Ray Traversal" (JCGT 2013): the exit distance is
+        // widened so rounding never culls a box the ray touches.
+        rvec4 enter = max(max(min(x0, x1), min(y0, y1)), max(min(z0, z1), rvec4(0.0)));
+        rvec4 leave = min(min(max(x0, x1), max(y0, y1)), min(max(z0, z1), rvec4(tHit))) * (1.0 + 8.0 * UNIT_ROUNDOFF);
+        bvec4 enters = bvec4(uvec4(lessThanEqual(enter, leave)) & uvec4(notEqual(child, uvec4(SNELL_BVH_EMPTY))));
+        // Children missed sort last, at +inf (an entered box's entry is finite).
+        real never = real(uintBitsToFloat(0x7f800000u));
+        rvec4 key = mix(rvec4(never), enter, enters);
+        real k0 = key.x, k1 = key.y, k2 = key.z, k3 = key.w;
+        uint c0 = child.x, c1 = child.y, c2 = child.z, c3 = child.w;
+        // A sorting network of four.
+        orderPair(k0, c0, k1, c1);
+        orderPair(k2, c2, k3, c3);
+        orderPair(k0, c0, k2, c2);
+        orderPair(k1, c1, k3, c3);
+        orderPair(k1, c1, k2, c2);
+        if (k3 < never) bvhStack[depth++] = c3;
+        if (k2 < never) bvhStack[depth++] = c2;
+        if (k1 < never) bvhStack[depth++] = c1;
+        if (k0 < never) {
+            entry = c0;
         } else {
             if (depth == 0u) break;
-            node = bvhStack[--depth];
-            code = texelFetch(bvhTexels, int(2u * node + 1u)).w;
+            entry = bvhStack[--depth];
         }
     }
     return hit;

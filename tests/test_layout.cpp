@@ -60,14 +60,17 @@ TEST(Layout, Light) {
 }
 
 TEST(Layout, BvhNode) {
-    EXPECT_EQ(sizeof(gpu::BvhNode), 32u);
-    EXPECT_EQ(offsetof(gpu::BvhNode, lower), 0u);
-    EXPECT_EQ(offsetof(gpu::BvhNode, upper), 16u);
+    EXPECT_EQ(sizeof(gpu::BvhNode), 16u * SNELL_BVH_NODE_TEXELS);
+    EXPECT_EQ(offsetof(gpu::BvhNode, lowerX), 0u);
+    EXPECT_EQ(offsetof(gpu::BvhNode, upperX), 16u);
+    EXPECT_EQ(offsetof(gpu::BvhNode, lowerZ), 64u);
+    EXPECT_EQ(offsetof(gpu::BvhNode, child), 96u);
 }
 
-// A node's links, stored as uint bits in the corners' w.
-std::uint32_t skipOf(const gpu::BvhNode& n) { return std::bit_cast<std::uint32_t>(n.lower.w); }
-std::uint32_t codeOf(const gpu::BvhNode& n) { return std::bit_cast<std::uint32_t>(n.upper.w); }
+// Child k's code (uint bits) and box corners.
+std::uint32_t childOf(const gpu::BvhNode& n, int k) { return std::bit_cast<std::uint32_t>(n.child[k]); }
+glm::vec3 lowerOf(const gpu::BvhNode& n, int k) { return {n.lowerX[k], n.lowerY[k], n.lowerZ[k]}; }
+glm::vec3 upperOf(const gpu::BvhNode& n, int k) { return {n.upperX[k], n.upperY[k], n.upperZ[k]}; }
 
 TEST(Layout, FrameParams) {
     EXPECT_EQ(sizeof(gpu::FrameParams), 192u);
@@ -289,41 +292,65 @@ TEST(GpuScene, BvhAboveTheThresholdHoldsEverySphereOnce) {
         }
         for (std::size_t i = 1; i <= n; ++i) EXPECT_EQ(seen.count(static_cast<int>(i)), 1u) << i;
 
-        // Walked in depth-first order, every box entered (next node for an
-        // inner node, skip after a leaf), the leaves cover [0, n) exactly
-        // once, each node is visited once, skips only go forward, an inner
-        // node's second child (its first child's skip) is a node, and each
-        // leaf's box contains its spheres' bounds.
+        // Walked from the root through every child: each node is reached once
+        // and only from a node before it, a node has at least two children
+        // and its empty lanes last, the leaves cover [0, n) exactly once and
+        // each child's box holds what is below it (a leaf's, its spheres'
+        // bounds), the depth is the longest path, and the stack the walk
+        // needs is sized from it.
         std::vector<int> covered(n, 0);
+        std::vector<int> reached(g.nodes.size(), 0);
         std::size_t visited = 0;
-        EXPECT_GE(g.bvhDepth, 2);
-        for (std::uint32_t i = 0; i < g.nodes.size();) {
-            ASSERT_LE(++visited, g.nodes.size());
+        int deepest = 0;
+        std::vector<std::pair<std::uint32_t, int>> open{{0u, 1}};
+        while (!open.empty()) {
+            const auto [i, depth] = open.back();
+            open.pop_back();
+            ASSERT_LT(i, g.nodes.size());
+            ASSERT_EQ(++reached[i], 1);
+            ++visited;
+            deepest = std::max(deepest, depth);
             const gpu::BvhNode& node = g.nodes[i];
-            ASSERT_GT(skipOf(node), i);
-            ASSERT_LE(skipOf(node), g.nodes.size());
-            const std::uint32_t code = codeOf(node);
-            if (code == SNELL_BVH_INNER) {
-                ASSERT_LT(skipOf(g.nodes[i + 1]), g.nodes.size());
-                ++i;
-                continue;
-            }
-            i = skipOf(node);
-            const std::uint32_t first = code >> 2, count = (code & 3) + 1;
-            ASSERT_LE(count, std::uint32_t(SNELL_BVH_MAX_LEAF));
-            for (std::uint32_t k = first; k < first + count; ++k) {
-                ASSERT_LT(k, n);
-                ++covered[k];
-                const glm::vec4 cr(centreOf(g.spheres[k]), g.spheres[k].anchorRadius.w);
-                // A true sphere's radius is exact; an ellipsoid's only bounds
-                // it, so only its centre is checked.
-                const float r = isEllipsoid(g.spheres[k]) ? 0.0f : cr.w;
-                for (int a = 0; a < 3; ++a) {
-                    EXPECT_LE(node.lower[a], cr[a] - r + 1e-5f);
-                    EXPECT_GE(node.upper[a], cr[a] + r - 1e-5f);
+            int children = 0;
+            for (int k = 0; k < SNELL_BVH_WIDTH; ++k) {
+                const std::uint32_t code = childOf(node, k);
+                if (code == SNELL_BVH_EMPTY) continue;
+                EXPECT_EQ(children++, k) << "empty lanes come last";
+                if ((code & SNELL_BVH_LEAF) == 0) {
+                    ASSERT_GT(code, i);
+                    ASSERT_LT(code, g.nodes.size());
+                    const gpu::BvhNode& below = g.nodes[code];
+                    for (int j = 0; j < SNELL_BVH_WIDTH; ++j) {
+                        if (childOf(below, j) == SNELL_BVH_EMPTY) continue;
+                        for (int a = 0; a < 3; ++a) {
+                            EXPECT_LE(lowerOf(node, k)[a], lowerOf(below, j)[a]);
+                            EXPECT_GE(upperOf(node, k)[a], upperOf(below, j)[a]);
+                        }
+                    }
+                    open.push_back({code, depth + 1});
+                    continue;
+                }
+                const std::uint32_t leaf = code & ~SNELL_BVH_LEAF;
+                const std::uint32_t first = leaf >> 2, count = (leaf & 3) + 1;
+                ASSERT_LE(count, std::uint32_t(SNELL_BVH_MAX_LEAF));
+                for (std::uint32_t s = first; s < first + count; ++s) {
+                    ASSERT_LT(s, n);
+                    ++covered[s];
+                    const glm::vec4 cr(centreOf(g.spheres[s]), g.spheres[s].anchorRadius.w);
+                    // A true sphere's radius is exact; an ellipsoid's only bounds
+                    // it, so only its centre is checked.
+                    const float r = isEllipsoid(g.spheres[s]) ? 0.0f : cr.w;
+                    for (int a = 0; a < 3; ++a) {
+                        EXPECT_LE(lowerOf(node, k)[a], cr[a] - r + 1e-5f);
+                        EXPECT_GE(upperOf(node, k)[a], cr[a] + r - 1e-5f);
+                    }
                 }
             }
+            EXPECT_GE(children, 2) << "node " << i;
         }
+        EXPECT_EQ(deepest, g.bvhDepth);
+        EXPECT_GE(g.bvhDepth, 2);
+        EXPECT_EQ(g.bvhStackSize(), (SNELL_BVH_WIDTH - 1) * g.bvhDepth);
         EXPECT_EQ(visited, g.nodes.size());
         for (std::size_t k = 0; k < n; ++k) EXPECT_EQ(covered[k], 1) << k;
     }

@@ -212,7 +212,7 @@ ComputeRenderer::Specialisation ComputeRenderer::specialise(const RenderRequest&
     if (unrolled)
         for (std::size_t i = 0; i < layout_.spheres.size(); ++i)
             if (layout_.spheres[i].anchorRadius.w < 0.0f) values[SNELL_SPEC_ELLIPSOID_MASK] |= 1u << i;
-    values[SNELL_SPEC_BVH_DEPTH] = static_cast<std::uint32_t>(std::max(1, layout_.bvhDepth));
+    values[SNELL_SPEC_BVH_DEPTH] = static_cast<std::uint32_t>(layout_.bvhStackSize());
     values[SNELL_SPEC_HAS_ELLIPSOIDS] = !layout_.ellipsoids.empty();
     values[SNELL_SPEC_HAS_REFRACTION] = hasRefraction;
     values[SNELL_SPEC_HAS_REFLECTION] = hasReflection;

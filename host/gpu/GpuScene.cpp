@@ -83,47 +83,73 @@ double primaryStartDistance(const snell::Scene& scene, const snell::dvec3& eye) 
 
 namespace {
 
+// The binary BVH's nodes gathered under a node of up to SNELL_BVH_WIDTH
+// children: starting from binary node n, the inner child of largest surface
+// is replaced by its two children while there is room (Wald et al.,
+// "Getting Rid of Packets", 2008, collapse a binary BVH this way). Fewer,
+// wider steps: each step tests four boxes at once.
+std::vector<std::uint32_t> wideChildren(const snell::Bvh& bvh, std::uint32_t n) {
+    std::vector<std::uint32_t> children{n};
+    while (children.size() < SNELL_BVH_WIDTH) {
+        std::size_t widest = children.size();
+        for (std::size_t k = 0; k < children.size(); ++k) {
+            const snell::BvhNode& c = bvh.nodes[children[k]];
+            if (c.count == 0 && (widest == children.size() ||
+                                 c.bounds.halfArea() > bvh.nodes[children[widest]].bounds.halfArea()))
+                widest = k;
+        }
+        if (widest == children.size()) break;
+        const std::uint32_t first = bvh.nodes[children[widest]].first;
+        children[widest] = first;
+        children.insert(children.begin() + static_cast<std::ptrdiff_t>(widest) + 1, first + 1);
+    }
+    return children;
+}
+
+// Lays out the wide node over binary node n (and, depth first, those below
+// it) from out.nodes' end; returns the depth of wide nodes from it.
+int layOutWideNode(const snell::Bvh& bvh, std::uint32_t n, const snell::dvec3& eye, GpuScene& out) {
+    const std::size_t index = out.nodes.size();
+    out.nodes.emplace_back();
+    const std::vector<std::uint32_t> children = wideChildren(bvh, n);
+    std::uint32_t codes[SNELL_BVH_WIDTH];
+    vec4 lower[SNELL_BVH_WIDTH], upper[SNELL_BVH_WIDTH];
+    int depth = 1;
+    for (std::size_t k = 0; k < SNELL_BVH_WIDTH; ++k) {
+        lower[k] = upper[k] = vec4(0.0f);
+        if (k >= children.size()) {
+            codes[k] = SNELL_BVH_EMPTY;
+            continue;
+        }
+        const snell::BvhNode& c = bvh.nodes[children[k]];
+        outwardBox(c.bounds, eye, lower[k], upper[k]);
+        if (c.count > 0) {
+            codes[k] = SNELL_BVH_LEAF | (c.first * 4 + c.count - 1);
+        } else {
+            codes[k] = static_cast<std::uint32_t>(out.nodes.size());
+            depth = std::max(depth, 1 + layOutWideNode(bvh, children[k], eye, out));
+        }
+    }
+    BvhNode& node = out.nodes[index];
+    for (int k = 0; k < SNELL_BVH_WIDTH; ++k) {
+        node.lowerX[k] = lower[k].x, node.upperX[k] = upper[k].x;
+        node.lowerY[k] = lower[k].y, node.upperY[k] = upper[k].y;
+        node.lowerZ[k] = lower[k].z, node.upperZ[k] = upper[k].z;
+        node.child[k] = std::bit_cast<float>(codes[k]);  // uint bits (shared_layout.h)
+    }
+    return depth;
+}
+
 // The BVH over the scene's spheres, laid out for the shader in out.nodes
-// (depth-first, with skip links); returns the spheres in leaf order.
+// (nodes of four children, depth first); returns the spheres in leaf order.
 std::vector<std::uint32_t> layOutBvh(const snell::Scene& scene, const snell::dvec3& eye, GpuScene& out) {
     const auto start = std::chrono::steady_clock::now();
     std::vector<snell::Aabb> bounds;
     bounds.reserve(scene.spheres.size());
     for (const snell::Sphere& s : scene.spheres) bounds.push_back(snell::sphereBounds(s));
     const snell::Bvh bvh = snell::buildBvh(bounds, SNELL_BVH_MAX_LEAF);
-    // Depth-first (pre-order) layout with skip links: a node's first child follows it, the
-    // second is its skip link (trace.comp walks it with a short stack).
-    std::vector<std::uint32_t> gpuIndexOf(bvh.nodes.size(), 0);
-    std::vector<std::uint32_t> preorder;
-    preorder.reserve(bvh.nodes.size());
-    std::vector<std::uint32_t> stack{0};
-    while (!stack.empty()) {
-        const std::uint32_t n = stack.back();
-        stack.pop_back();
-        gpuIndexOf[n] = static_cast<std::uint32_t>(preorder.size());
-        preorder.push_back(n);
-        if (bvh.nodes[n].count == 0) {
-            stack.push_back(bvh.nodes[n].first + 1);
-            stack.push_back(bvh.nodes[n].first);
-        }
-    }
-    // Subtree sizes give the skip links: skip = own index + subtree size.
-    std::vector<std::uint32_t> subtree(bvh.nodes.size(), 1);
-    for (auto it = preorder.rbegin(); it != preorder.rend(); ++it) {
-        const snell::BvhNode& n = bvh.nodes[*it];
-        if (n.count == 0) subtree[*it] = 1 + subtree[n.first] + subtree[n.first + 1];
-    }
-    out.nodes.reserve(preorder.size());
-    for (std::uint32_t n : preorder) {
-        const snell::BvhNode& b = bvh.nodes[n];
-        BvhNode node;
-        outwardBox(b.bounds, eye, node.lower, node.upper);
-        // Links as uint bits (shared_layout.h).
-        node.lower.w = std::bit_cast<float>(gpuIndexOf[n] + subtree[n]);
-        node.upper.w = std::bit_cast<float>(b.count > 0 ? b.first * 4 + b.count - 1 : SNELL_BVH_INNER);
-        out.nodes.push_back(node);
-    }
-    out.bvhDepth = bvh.depth;
+    out.nodes.reserve(bvh.nodes.size() / 2 + 1);
+    out.bvhDepth = layOutWideNode(bvh, 0, eye, out);
     out.bvhBuildMs = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
     return bvh.order;
 }

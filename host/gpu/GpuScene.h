@@ -6,6 +6,7 @@
 // spheres are in BVH leaf order when a BVH is used. No Vulkan here.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <vector>
 
@@ -20,7 +21,8 @@ static_assert(sizeof(Sphere) == 32 && offsetof(Sphere, normal) == 16);
 static_assert(sizeof(Ellipsoid) == 48 && offsetof(Ellipsoid, row2) == 32);
 static_assert(sizeof(Material) == 48 && offsetof(Material, kt) == 32);
 static_assert(sizeof(Light) == 32 && offsetof(Light, colour) == 16);
-static_assert(sizeof(BvhNode) == 32 && offsetof(BvhNode, upper) == 16);
+static_assert(sizeof(BvhNode) == 16 * SNELL_BVH_NODE_TEXELS && offsetof(BvhNode, upperX) == 16 &&
+              offsetof(BvhNode, child) == 96);
 static_assert(sizeof(SphereBlock) == 32 * SNELL_BLOCK_SPHERES);
 static_assert(sizeof(FrameParams) == 192 && offsetof(FrameParams, cornerDir) == 16 &&
               offsetof(FrameParams, radiance) == 96 && offsetof(FrameParams, imageWidth) == 128 &&
@@ -80,6 +82,9 @@ struct GpuScene {
     snell::dvec3 origin{0.0};    // the world point that is the origin on the GPU
     double primaryStart = 0.0;   // distance from the eye at which primary rays start
     int bvhDepth = 0;            // nodes on the longest root-to-leaf path
+    // Entries the walk's stack needs: each node it enters leaves at most
+    // all but one of its children waiting.
+    int bvhStackSize() const { return std::max(1, (SNELL_BVH_WIDTH - 1) * bvhDepth); }
     double bvhBuildMs = 0.0;
 
     bool usesBvh() const { return !nodes.empty(); }
