@@ -195,10 +195,47 @@ uint traverseBvh(rvec3 origin, real originLength, rvec3 dir, uint fromSphere, ui
     uint hit = NONE;
     uint entry = 0u;  // in hand: a node's index, or SNELL_BVH_LEAF | a leaf's code
     uint depth = 0u;  // entries on the stack
-    while (true) {
+    bool walking = true;
+    while (walking) {
         tick(1u);
         if (COUNT_LANES) countLanes(true, walkSlots, walkBusy);
-        if ((entry & SNELL_BVH_LEAF) != 0u) {
+        // A pass takes an inner node, then the leaf in hand if there is one
+        // (the node's nearest child, or the next waiting entry): one pass for
+        // both, so lanes at leaves and lanes at nodes go on together.
+        if ((entry & SNELL_BVH_LEAF) == 0u) {
+            int base = int(entry) * SNELL_BVH_NODE_TEXELS;
+            rvec4 x0 = (nodeVector(base) - origin.x) * inverseDir.x;
+            rvec4 x1 = (nodeVector(base + 1) - origin.x) * inverseDir.x;
+            rvec4 y0 = (nodeVector(base + 2) - origin.y) * inverseDir.y;
+            rvec4 y1 = (nodeVector(base + 3) - origin.y) * inverseDir.y;
+            rvec4 z0 = (nodeVector(base + 4) - origin.z) * inverseDir.z;
+            rvec4 z1 = (nodeVector(base + 5) - origin.z) * inverseDir.z;
+            uvec4 child = texelFetch(bvhTexels, base + 6);
+            // The slab test within [0, tHit] against boxes stored rounded outwards;
+            // Ize, "Robust BVH Ray Traversal" (JCGT 2013): the exit distance is
+            // widened so rounding never culls a box the ray touches.
+            rvec4 enter = max(max(min(x0, x1), min(y0, y1)), max(min(z0, z1), rvec4(0.0)));
+            rvec4 leave = min(min(max(x0, x1), max(y0, y1)), min(max(z0, z1), rvec4(tHit))) * (1.0 + 8.0 * UNIT_ROUNDOFF);
+            bvec4 enters = bvec4(uvec4(lessThanEqual(enter, leave)) & uvec4(notEqual(child, uvec4(SNELL_BVH_EMPTY))));
+            // Children missed sort last, at +inf (an entered box's entry is finite).
+            real never = real(uintBitsToFloat(0x7f800000u));
+            rvec4 key = mix(rvec4(never), enter, enters);
+            real k0 = key.x, k1 = key.y, k2 = key.z, k3 = key.w;
+            uint c0 = child.x, c1 = child.y, c2 = child.z, c3 = child.w;
+            // A sorting network of four.
+            orderPair(k0, c0, k1, c1);
+            orderPair(k2, c2, k3, c3);
+            orderPair(k0, c0, k2, c2);
+            orderPair(k1, c1, k3, c3);
+            orderPair(k1, c1, k2, c2);
+            if (k3 < never) bvhStack[depth++] = c3;
+            if (k2 < never) bvhStack[depth++] = c2;
+            if (k1 < never) bvhStack[depth++] = c1;
+            if (k0 < never) entry = c0;
+            else if (depth > 0u) entry = bvhStack[--depth];
+            else walking = false;
+        }
+        if (walking && (entry & SNELL_BVH_LEAF) != 0u) {
             // A leaf: spheres first · 4 + count − 1 = code.
             uint code = entry & ~SNELL_BVH_LEAF;
             uint first = code >> 2;
@@ -210,43 +247,8 @@ uint traverseBvh(rvec3 origin, real originLength, rvec3 dir, uint fromSphere, ui
                     if (t < tHit) { tHit = t; hit = i; }
                 }
             }
-            if ((anyHit && hit != NONE) || depth == 0u) break;
-            entry = bvhStack[--depth];
-            continue;
-        }
-        int base = int(entry) * SNELL_BVH_NODE_TEXELS;
-        rvec4 x0 = (nodeVector(base) - origin.x) * inverseDir.x;
-        rvec4 x1 = (nodeVector(base + 1) - origin.x) * inverseDir.x;
-        rvec4 y0 = (nodeVector(base + 2) - origin.y) * inverseDir.y;
-        rvec4 y1 = (nodeVector(base + 3) - origin.y) * inverseDir.y;
-        rvec4 z0 = (nodeVector(base + 4) - origin.z) * inverseDir.z;
-        rvec4 z1 = (nodeVector(base + 5) - origin.z) * inverseDir.z;
-        uvec4 child = texelFetch(bvhTexels, base + 6);
-        // The slab test within [0, tHit] against boxes stored rounded outwards;
-        // Ize, "Robust BVH Ray Traversal" (JCGT 2013): the exit distance is
-        // widened so rounding never culls a box the ray touches.
-        rvec4 enter = max(max(min(x0, x1), min(y0, y1)), max(min(z0, z1), rvec4(0.0)));
-        rvec4 leave = min(min(max(x0, x1), max(y0, y1)), min(max(z0, z1), rvec4(tHit))) * (1.0 + 8.0 * UNIT_ROUNDOFF);
-        bvec4 enters = bvec4(uvec4(lessThanEqual(enter, leave)) & uvec4(notEqual(child, uvec4(SNELL_BVH_EMPTY))));
-        // Children missed sort last, at +inf (an entered box's entry is finite).
-        real never = real(uintBitsToFloat(0x7f800000u));
-        rvec4 key = mix(rvec4(never), enter, enters);
-        real k0 = key.x, k1 = key.y, k2 = key.z, k3 = key.w;
-        uint c0 = child.x, c1 = child.y, c2 = child.z, c3 = child.w;
-        // A sorting network of four.
-        orderPair(k0, c0, k1, c1);
-        orderPair(k2, c2, k3, c3);
-        orderPair(k0, c0, k2, c2);
-        orderPair(k1, c1, k3, c3);
-        orderPair(k1, c1, k2, c2);
-        if (k3 < never) bvhStack[depth++] = c3;
-        if (k2 < never) bvhStack[depth++] = c2;
-        if (k1 < never) bvhStack[depth++] = c1;
-        if (k0 < never) {
-            entry = c0;
-        } else {
-            if (depth == 0u) break;
-            entry = bvhStack[--depth];
+            if ((anyHit && hit != NONE) || depth == 0u) walking = false;
+            else entry = bvhStack[--depth];
         }
     }
     return hit;
