@@ -189,7 +189,7 @@ struct BvhNode {
     vec4 child;  // uint bits
 };
 #define SNELL_BVH_NODE_TEXELS 7
-#define SNELL_BVH_WIDTH 4
+#define SNELL_BVH_WIDTH 4  // a node's children: the lanes of its vec4s
 #define SNELL_BVH_MAX_LEAF 4
 #define SNELL_BVH_LEAF 0x80000000u
 #define SNELL_BVH_EMPTY 0xffffffffu
