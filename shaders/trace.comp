@@ -38,7 +38,7 @@ layout(constant_id = SNELL_SPEC_SPHERE_COUNT) const uint SPHERE_COUNT = 1u;
 layout(constant_id = SNELL_SPEC_ELLIPSOID_MASK) const uint ELLIPSOID_MASK = 0u;
 // Every sphere is in the uniform block (SNELL_BLOCK_SPHERES at most).
 layout(constant_id = SNELL_SPEC_SPHERES_IN_BLOCK) const bool SPHERES_IN_BLOCK = false;
-// With a BVH: the deepest path from the root, which bounds the traversal stack.
+// With a BVH: the entries of the walk's stack (GpuScene::bvhStackSize).
 layout(constant_id = SNELL_SPEC_BVH_DEPTH) const uint BVH_DEPTH = 1u;
 layout(constant_id = SNELL_SPEC_HAS_ELLIPSOIDS) const bool HAS_ELLIPSOIDS = true;
 layout(constant_id = SNELL_SPEC_HAS_REFRACTION) const bool HAS_REFRACTION = true;
