@@ -281,8 +281,20 @@ struct FrameParams {
     uint pad0;
 };
 
+// Interleaved tiles (ComputeRenderer) take the image's columns in runs of a
+// SIMD row's width and its rows one by one: runs that fine keep the tiles
+// fair samples of a finely structured image (runs of 64 columns left the
+// tiles of becker-SphereFlake2 at 1400² 16 against 29 s), and cost the
+// kernel no more than coarse ones (docs/performance.md).
+#define SNELL_TILE_COLUMN_RUN 8
+#define SNELL_TILE_ROW_RUN 1
+
 // Push constants: the tile of the image this dispatch covers, and whether it
-// resumes the invocations' suspended work (SlotState) or starts afresh.
+// resumes the invocations' suspended work (SlotState) or starts afresh. A
+// tile is either a block of the image (strides 1) or every strideX-th run of
+// columns and strideY-th run of rows of it (ComputeRenderer: interleaved
+// tiles): its pixel (x, y) is the image's (originX + (x − x mod C) · strideX
+// + x mod C, originY + (y − y mod R) · strideY + y mod R), C and R the runs.
 struct TileParams {
     uint originX;
     uint originY;
@@ -292,8 +304,8 @@ struct TileParams {
     // Workgroup g takes share (g · workgroupStride) mod W of the tile's W
     // shares of pixels (trace.comp, takePixel); coprime with W.
     uint workgroupStride;
-    uint pad1;
-    uint pad2;
+    uint strideX;
+    uint strideY;
 };
 
 #ifdef __cplusplus

@@ -856,6 +856,13 @@ bool endStep(uint slot, inout SlotState state, inout uvec2 pixel, inout float cu
     return state.pixel >= tilePixels;
 }
 
+// The image's pixel of the tile's pixel p (TileParams).
+uvec2 imagePixel(uvec2 p) {
+    const uvec2 run = uvec2(SNELL_TILE_COLUMN_RUN, SNELL_TILE_ROW_RUN);
+    uvec2 inRun = p % run;
+    return uvec2(tile.originX, tile.originY) + (p - inRun) * uvec2(tile.strideX, tile.strideY) + inRun;
+}
+
 // The next ray of the pixel's current step: a child waiting on the stack,
 // else a ray the last step left in the frontier, else a camera ray for its
 // next sample. False where the step has none left.
@@ -872,7 +879,7 @@ bool nextRay(uint slot, inout SlotState state, uvec2 pixel, out Ray ray) {
         return true;
     }
     if (state.started < samples) {
-        ray = cameraRay(pixel + uvec2(tile.originX, tile.originY), frame.firstSample + state.started);
+        ray = cameraRay(imagePixel(pixel), frame.firstSample + state.started);
         state.started++;
         if (COUNT_RAYS) countedRays[SNELL_COUNTER_PRIMARY]++;
         return true;

@@ -5,6 +5,7 @@
 // scenes. Runs on lavapipe in CI and is never skipped: no Vulkan device is
 // a failure. On failure the GPU image, the reference and a difference image are
 // written to build/test-artifacts/ and named in the message.
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <map>
@@ -426,6 +427,67 @@ TEST(GpuProgress, PixelRaysAndSharesOfTheTile) { checkPixelRaysAndShares(SNELL_S
 // tile's progress comes from its workgroups' schedule.
 TEST(GpuProgress, PixelRaysAndSharesOfATileOfOwnShares) {
     checkPixelRaysAndShares(SNELL_SOURCE_DIR "/scenes/mirrors.scn");
+}
+
+}  // namespace
+
+namespace {
+
+// Interleaved tiles (each every other run of columns and rows of the window)
+// cover the window's pixels once each, and give the very image, bounds and
+// pixel costs of tiles in blocks, streamed or whole; the probe's regions
+// split the window between them by their pixels.
+TEST(GpuTiles, InterleavedTilesGiveTheImageOfBlocks) {
+    const snell::PixelWindow window{5, 0, 1100, 1090};  // runs that do not divide it
+    const std::vector<snell::RenderRegion> regions = snell::ComputeRenderer::tiles(window, true);
+    ASSERT_EQ(regions.size(), 4u);
+    double shares = 0.0;
+    for (const snell::RenderRegion& r : regions) {
+        EXPECT_EQ(r.window.x0, window.x0);
+        EXPECT_EQ(r.window.y1, window.y1);
+        shares += r.share;
+    }
+    EXPECT_NEAR(shares, 1.0, 1e-12);
+    EXPECT_EQ(snell::ComputeRenderer::tiles(window, false)[1].window.x0, window.x0 + snell::ComputeRenderer::kMaxTileSide);
+
+    const snell::Scene scene = snell::parseSceneFile(SNELL_SOURCE_DIR "/scenes/example.scn");
+    snell::ComputeRenderer gpu(context(), scene, snell::Camera::fromSpec(1100, scene.halfWidth));
+    struct Rendered {
+        snell::Image image;
+        std::vector<float> bound, rays;
+        std::vector<double> fractions;
+    };
+    auto render = [&](bool interleaved, bool streamed) {
+        snell::RenderRequest request;
+        request.width = request.height = 1100;
+        request.window = window;
+        request.camera = snell::Camera::fromSpec(1100, scene.halfWidth);
+        request.trace = snell::kDefaultSettings;
+        request.interleavedTiles = interleaved;
+        Rendered out;
+        request.boundImage = &out.bound;
+        request.rayImage = &out.rays;
+        request.progress = [&](double fraction, std::uint64_t) { out.fractions.push_back(fraction); };
+        std::vector<float> rows;
+        if (streamed) request.rowSink = [&](const float* rgb, int n) { rows.insert(rows.end(), rgb, rgb + n * window.width() * 3); };
+        snell::GpuRenderResult result = gpu.render(request, false);
+        EXPECT_EQ(result.tiles, 4);
+        out.image = std::move(result.image);
+        if (streamed) out.image.rgb = rows;
+        return out;
+    };
+    const Rendered blocks = render(false, false);
+    ASSERT_EQ(blocks.image.rgb.size(), std::size_t(window.width()) * window.height() * 3);
+    for (bool streamed : {false, true}) {
+        SCOPED_TRACE(streamed ? "streamed" : "whole");
+        const Rendered interleaved = render(true, streamed);
+        EXPECT_EQ(interleaved.image.rgb, blocks.image.rgb);
+        EXPECT_EQ(interleaved.bound, blocks.bound);
+        EXPECT_EQ(interleaved.rays, blocks.rays);
+        ASSERT_FALSE(interleaved.fractions.empty());
+        EXPECT_EQ(interleaved.fractions.back(), 1.0);
+        EXPECT_TRUE(std::is_sorted(interleaved.fractions.begin(), interleaved.fractions.end()));
+    }
 }
 
 }  // namespace

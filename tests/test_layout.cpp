@@ -106,6 +106,8 @@ TEST(Layout, TileParams) {
     EXPECT_EQ(offsetof(gpu::TileParams, width), 8u);
     EXPECT_EQ(offsetof(gpu::TileParams, height), 12u);
     EXPECT_EQ(offsetof(gpu::TileParams, resume), 16u);
+    EXPECT_EQ(offsetof(gpu::TileParams, strideX), 24u);
+    EXPECT_EQ(offsetof(gpu::TileParams, strideY), 28u);
 }
 
 TEST(Layout, SlotStateAndPendingRay) {

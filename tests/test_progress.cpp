@@ -121,3 +121,19 @@ TEST(ProgressTimeLeft, AShareOfPixelsIsWeighedAgainstTheExpectation) {
 }
 
 }  // namespace
+
+namespace {
+
+TEST(ProgressTimeLeft, AlikeRegionsTakeWhatTheFinishedOnesTook) {
+    Progress progress(false);
+    // Interleaved tiles: the probe expects 1 s each, the first took 10 s. The
+    // second, 5 s in, says it is nine tenths done (its forecast errs in its
+    // last pixels): it is taken to need 5 s more, and the other two 10 s each.
+    progress.expectCost({1, 1, 1, 1}, {1e6, 1e6, 1e6, 1e6}, true, true);
+    progress.secondsLeft(10.0, 1 * kQuarter, kNoRays);
+    EXPECT_NEAR(progress.secondsLeft(15.0, 1.9 * kQuarter, kNoRays), 25.0, 1e-9);
+    // Past what the first took, its own pace says: 12 s in at nine tenths.
+    EXPECT_NEAR(progress.secondsLeft(22.0, 1.9 * kQuarter, kNoRays), 12.0 / 0.9 * 0.1 + 2 * 22.0 / 2.0, 1e-9);
+}
+
+}  // namespace

@@ -42,9 +42,11 @@ void Progress::show(double fraction, std::uint64_t rays) {
     std::fflush(stderr);
 }
 
-void Progress::expectCost(const std::vector<double>& seconds, const std::vector<double>& rays, bool sharesOfTime) {
+void Progress::expectCost(const std::vector<double>& seconds, const std::vector<double>& rays, bool sharesOfTime,
+                          bool alike) {
     std::lock_guard<std::mutex> lock(mutex_);
     sharesOfTime_ = sharesOfTime;
+    alike_ = alike;
     for (auto [model, costs] : {std::pair{&time_, &seconds}, std::pair{&rays_, &rays}}) {
         model->cumulative.assign(1, 0.0);
         for (double c : *costs) model->cumulative.push_back(model->cumulative.back() + c);
@@ -95,6 +97,15 @@ double Progress::secondsLeft(double elapsed, double fraction, double rays) {
     const double inRegion = elapsed - secondsWhenDone_;
     const double share = fraction * double(regions) - double(regionsDone_);
     const double progress = sharesOfTime_ ? std::clamp(share, 0.0, 0.999) : regionProgress(share, rays - raysWhenDone_);
+    if (alike_ && regionsDone_ > 0) {
+        // Alike regions: the current one takes what the finished ones took,
+        // unless it has run past that (then its own pace says).
+        const double pace = m.pace(regionsDone_, secondsWhenDone_);
+        const double expectedLeft = pace * costCurrent - inRegion;
+        const double ownLeft = progress > 0.01 ? inRegion * (1.0 - progress) / progress : 0.0;
+        const double paceNow = elapsed / (costDone + costCurrent);
+        return expectedLeft > 0.0 ? pace * costAfter + expectedLeft : ownLeft + paceNow * costAfter;
+    }
     // The pace of the work done so far, the current region's share of its
     // cost included once it has made some progress (the probe's time
     // overstates a small probe whose few expensive pixels ran alone); before

@@ -44,7 +44,12 @@ public:
     // Each region's expected seconds and rays, in order; the render starts now.
     // `sharesOfTime`: the renderer reports the region in progress by the
     // share of its time done (RenderRequest::expectedCost), not of its pixels.
-    void expectCost(const std::vector<double>& seconds, const std::vector<double>& rays, bool sharesOfTime = false);
+    // `alike`: the regions are fair samples of one image (interleaved tiles),
+    // so once one has finished, the pace of the finished ones foretells the
+    // region in progress better than its own progress, whose forecast errs
+    // most in its last pixels.
+    void expectCost(const std::vector<double>& seconds, const std::vector<double>& rays, bool sharesOfTime = false,
+                    bool alike = false);
     // The time left after `elapsed` seconds of rendering, with `fraction`
     // (regions finished plus the current one's share of pixels, over their
     // count) done and `rays` traced. Also notes the regions finished.
@@ -70,6 +75,7 @@ private:
     double regionProgress(double pixels, double rays) const;
     CostModel time_, rays_;
     bool sharesOfTime_ = false;
+    bool alike_ = false;
     std::size_t regionsDone_ = 0;
     double secondsWhenDone_ = 0.0;       // the render's time when the last finished region ended
     double raysWhenDone_ = 0.0;          // and its rays traced by then

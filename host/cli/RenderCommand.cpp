@@ -5,8 +5,11 @@
 #include <cstdio>
 #include <iostream>
 #include <memory>
+#include <numeric>
+#include <optional>
 #include <sstream>
 #include <thread>
+#include <tuple>
 
 #include "common/Clock.h"
 #include "check/SceneCheck.h"
@@ -105,7 +108,8 @@ struct RenderOutcome {
 // For the progress bar's time left: the time and the rays each region of
 // the image costs, in the order the renderer finishes them, measured on a
 // render of one pixel in 256 (every 16th row and column of the same image),
-// region by region, costing about 1/256 of the render (Progress says which
+// region by region (a window once, whatever the regions that share it),
+// costing about 1/256 of the render (Progress says which
 // of the two it trusts). From 256² camera rays on: the image's size says
 // little of the render's time (an amplifying scene at 1400² renders longer
 // than a simple one at 8192²), and the probe's 16² or more pixels cost
@@ -114,13 +118,13 @@ struct RenderOutcome {
 // 16 × 16 pixels around it, by which the renderer weighs the pixels of the
 // region in progress.
 template <class Render>
-void estimateCost(const Scene& scene, const RenderRequest& request, const std::vector<PixelWindow>& regions,
+double estimateCost(const Scene& scene, const RenderRequest& request, const std::vector<RenderRegion>& regions,
                   Progress& progress, RenderOutcome& outcome, Render render, CostMap* map = nullptr) {
     constexpr int kStride = 16;
     constexpr double kMinCameraRays = 1 << 16;
     const PixelWindow area = request.area();
     const double cameraRays = double(area.width()) * area.height() * request.supersample * request.supersample;
-    if (cameraRays < kMinCameraRays) return;
+    if (cameraRays < kMinCameraRays) return 0.0;
     RenderRequest probe;
     probe.width = probe.height = std::max(1, request.width / kStride);
     probe.camera = Camera::fromSpec(probe.width, scene.halfWidth);
@@ -131,33 +135,48 @@ void estimateCost(const Scene& scene, const RenderRequest& request, const std::v
     std::vector<double> seconds, rays;
     std::vector<float> pixelRays;
     if (map) *map = CostMap{kStride, probe.width, probe.height, std::vector<float>(std::size_t(probe.width) * probe.height)};
-    for (const PixelWindow& r : regions) {
-        const int x0 = std::min(r.x0 / kStride, probe.width - 1), y0 = std::min(r.y0 / kStride, probe.height - 1);
-        probe.window = {x0, y0, std::max(r.x1 / kStride, x0 + 1), std::max(r.y1 / kStride, y0 + 1)};
-        // In the render's own terms: the probe saw one pixel in (its share of) the region's.
-        const PixelWindow seen = probe.area();
-        const double share = double(r.width()) * r.height() / (double(seen.width()) * seen.height());
-        probe.rayImage = map ? &pixelRays : nullptr;
-        const auto [ms, probeRays] = render(probe);
-        seconds.push_back(1e-3 * ms * share);
-        rays.push_back(probeRays * share);
-        if (map && pixelRays.size() == std::size_t(seen.width()) * seen.height())
-            for (int y = 0; y < seen.height(); ++y)
-                std::copy_n(pixelRays.begin() + std::ptrdiff_t(y) * seen.width(), seen.width(),
-                            map->cells.begin() + std::ptrdiff_t(seen.y0 + y) * map->width + seen.x0);
+    std::optional<PixelWindow> last;
+    double windowMs = 0.0, windowRays = 0.0, scale = 0.0;
+    for (const RenderRegion& region : regions) {
+        const PixelWindow& r = region.window;
+        if (last != r) {
+            last = r;
+            const int x0 = std::min(r.x0 / kStride, probe.width - 1), y0 = std::min(r.y0 / kStride, probe.height - 1);
+            probe.window = {x0, y0, std::max(r.x1 / kStride, x0 + 1), std::max(r.y1 / kStride, y0 + 1)};
+            // In the render's own terms: the probe saw one pixel in (its share of) the window's.
+            const PixelWindow seen = probe.area();
+            scale = double(r.width()) * r.height() / (double(seen.width()) * seen.height());
+            probe.rayImage = map ? &pixelRays : nullptr;
+            std::tie(windowMs, windowRays) = render(probe);
+            if (map && pixelRays.size() == std::size_t(seen.width()) * seen.height())
+                for (int y = 0; y < seen.height(); ++y)
+                    std::copy_n(pixelRays.begin() + std::ptrdiff_t(y) * seen.width(), seen.width(),
+                                map->cells.begin() + std::ptrdiff_t(seen.y0 + y) * map->width + seen.x0);
+        }
+        seconds.push_back(1e-3 * windowMs * scale * region.share);
+        rays.push_back(windowRays * scale * region.share);
     }
-    outcome.estimateMs = msSince(start);
+    outcome.estimateMs += msSince(start);
     if (map && std::all_of(map->cells.begin(), map->cells.end(), [](float c) { return c == 0.0f; })) *map = {};
-    progress.expectCost(seconds, rays, map && !map->empty());
+    // Regions that share one window are its interleaved tiles: alike.
+    const bool alike = regions.size() > 1 && std::all_of(regions.begin(), regions.end(), [&](const RenderRegion& r) {
+        return r.window == regions[0].window;
+    });
+    progress.expectCost(seconds, rays, map && !map->empty(), alike);
+    return std::accumulate(seconds.begin(), seconds.end(), 0.0);
 }
 
+// Renders expected to take at least this many seconds are traced in
+// interleaved tiles (RenderRequest::interleavedTiles).
+constexpr double kInterleaveFrom = 2.0;
+
 // The CPU reference finishes rows top to bottom: its regions are bands of rows.
-std::vector<PixelWindow> rowBands(const PixelWindow& area) {
+std::vector<RenderRegion> rowBands(const PixelWindow& area) {
     constexpr int kBands = 32;
-    std::vector<PixelWindow> bands;
+    std::vector<RenderRegion> bands;
     const int count = std::min(kBands, area.height());
     for (int b = 0; b < count; ++b)
-        bands.push_back({area.x0, area.y0 + area.height() * b / count, area.x1, area.y0 + area.height() * (b + 1) / count});
+        bands.push_back({{area.x0, area.y0 + area.height() * b / count, area.x1, area.y0 + area.height() * (b + 1) / count}});
     return bands;
 }
 
@@ -399,14 +418,24 @@ RenderOutcome RenderCommand::renderOnGpu(const Scene& scene, RenderRequest& requ
         // render does), so the render reuses it rather than compiling a second
         // one (seconds on a cold shader cache) inside the time the bar counts.
         CostMap expectedCost;
-        if (progress.enabled())
-            estimateCost(scene, request, ComputeRenderer::tiles(request.area()), progress, r,
-                         [&](const RenderRequest& probe) {
-                             const GpuRenderResult g = renderer.render(probe, o_.stats);
-                             r.pipelineMs += g.pipelineMs;
-                             return std::pair(g.renderMs, double(g.tracedRays));
-                         },
-                         &expectedCost);
+        if (progress.enabled()) {
+            auto probe = [&](const RenderRequest& sparse) {
+                const GpuRenderResult g = renderer.render(sparse, o_.stats);
+                r.pipelineMs += g.pipelineMs;
+                return std::pair(g.renderMs, double(g.tracedRays));
+            };
+            // A render long enough for its time left to matter is traced in
+            // interleaved tiles (their probe is one sparse render of the
+            // whole); a short one in blocks, which is cheaper on cheap scenes.
+            const PixelWindow area = request.area();
+            request.interleavedTiles = ComputeRenderer::interleaves(area);
+            const double seconds = estimateCost(scene, request, ComputeRenderer::tiles(area, request.interleavedTiles),
+                                                progress, r, probe, &expectedCost);
+            if (request.interleavedTiles && seconds < kInterleaveFrom) {
+                request.interleavedTiles = false;
+                estimateCost(scene, request, ComputeRenderer::tiles(area, false), progress, r, probe, &expectedCost);
+            }
+        }
         if (!expectedCost.empty()) request.expectedCost = &expectedCost;
         const GpuRenderResult g = renderer.render(request, o_.stats);
         request.expectedCost = nullptr;  // expectedCost ends here

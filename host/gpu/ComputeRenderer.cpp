@@ -380,29 +380,49 @@ constexpr VkDeviceSize kStackBudget = 64ull << 20;
 // enough that the cores finish together.
 constexpr unsigned kCpuWorkgroupsPerCore = 8;
 
-}  // namespace
-
-std::vector<PixelWindow> ComputeRenderer::tiles(const PixelWindow& area) {
-    const int tileW = std::min(kMaxTileSide, area.width()), tileH = std::min(kMaxTileSide, area.height());
-    std::vector<PixelWindow> out;
-    for (int y = area.y0; y < area.y1; y += tileH)
-        for (int x = area.x0; x < area.x1; x += tileW)
-            out.push_back({x, y, std::min(x + tileW, area.x1), std::min(y + tileH, area.y1)});
-    return out;
+// The image's column and row of the tile's column x and row y (TileParams;
+// trace.comp, imagePixel).
+int imageColumn(const gpu::TileParams& tile, std::uint32_t x) {
+    const std::uint32_t run = SNELL_TILE_COLUMN_RUN, inRun = x % run;
+    return int(tile.originX + (x - inRun) * tile.strideX + inRun);
+}
+int imageRow(const gpu::TileParams& tile, std::uint32_t y) {
+    const std::uint32_t run = SNELL_TILE_ROW_RUN, inRun = y % run;
+    return int(tile.originY + (y - inRun) * tile.strideY + inRun);
+}
+// Of `size` columns (rows) dealt in runs of `run` to `tiles` tiles in turn,
+// those of tile `t`: `run` of each full round, then what the last round
+// leaves for its run.
+int dealtTo(int t, int tiles, int size, int run) {
+    const int round = run * tiles;
+    return size / round * run + std::clamp(size % round - t * run, 0, run);
 }
 
-// How render() covers its window: square tiles of at most kMaxTileSide (16 MiB
-// of float image), each traced by the same persistent invocations.
+}  // namespace
+
+// How render() covers its window: tiles of at most kMaxTileSide² pixels (16
+// MiB of float image), each traced by the same persistent invocations;
+// interleaved up to kMaxInterleavedSide, else blocks.
 struct ComputeRenderer::TilePlan {
     PixelWindow area;  // the window rendered; pixel coordinates stay the whole image's
-    int tileWidth = 0, tileHeight = 0, tilesX = 0, tilesY = 0;
+    int tileWidth = 0, tileHeight = 0, tilesX = 0, tilesY = 0;  // the largest tile's size
+    bool interleaved = false;  // tile (i, j): every tilesX-th run of columns from run i, and so rows (TileParams)
     VkDeviceSize invocations = 0;
     std::uint32_t workgroupStride = 1;  // TileParams::workgroupStride
     // Whether workgroups help with each other's shares once theirs is taken
     // (SNELL_SPEC_HELPS): then what a workgroup finished is not its share's.
     bool helps = false;
 
+    TilePlan(const PixelWindow& window, bool interleave) : area(window) {
+        tilesX = (area.width() + kMaxTileSide - 1) / kMaxTileSide;
+        tilesY = (area.height() + kMaxTileSide - 1) / kMaxTileSide;
+        interleaved = interleave && interleaves(area);
+        tileWidth = interleaved ? tile(0, 0).width : std::min(kMaxTileSide, area.width());
+        tileHeight = interleaved ? tile(0, 0).height : std::min(kMaxTileSide, area.height());
+    }
     int count() const { return tilesX * tilesY; }
+    // The rows streamed at a time: a row of blocks, or the whole of interleaved tiles.
+    int bandRows() const { return interleaved ? area.height() : tileHeight; }
     std::uint64_t workgroups() const { return invocations / SNELL_WORKGROUP_SIZE; }
     // The share of the tile's pixels workgroup w takes (trace.comp, takePixel).
     std::uint64_t shareOf(std::uint64_t w) const { return w * workgroupStride % workgroups(); }
@@ -410,14 +430,44 @@ struct ComputeRenderer::TilePlan {
     // Tile (tx, ty): where it is, and how an invocation steps through it.
     gpu::TileParams tile(int tx, int ty) const {
         gpu::TileParams t{};
-        t.originX = std::uint32_t(area.x0 + tx * tileWidth);
-        t.originY = std::uint32_t(area.y0 + ty * tileHeight);
-        t.width = std::uint32_t(std::min(tileWidth, area.width() - tx * tileWidth));
-        t.height = std::uint32_t(std::min(tileHeight, area.height() - ty * tileHeight));
+        if (interleaved) {
+            t.originX = std::uint32_t(area.x0 + tx * SNELL_TILE_COLUMN_RUN);
+            t.originY = std::uint32_t(area.y0 + ty * SNELL_TILE_ROW_RUN);
+            t.width = std::uint32_t(dealtTo(tx, tilesX, area.width(), SNELL_TILE_COLUMN_RUN));
+            t.height = std::uint32_t(dealtTo(ty, tilesY, area.height(), SNELL_TILE_ROW_RUN));
+            t.strideX = std::uint32_t(tilesX);
+            t.strideY = std::uint32_t(tilesY);
+        } else {
+            t.originX = std::uint32_t(area.x0 + tx * tileWidth);
+            t.originY = std::uint32_t(area.y0 + ty * tileHeight);
+            t.width = std::uint32_t(std::min(tileWidth, area.width() - tx * tileWidth));
+            t.height = std::uint32_t(std::min(tileHeight, area.height() - ty * tileHeight));
+            t.strideX = t.strideY = 1;
+        }
         t.workgroupStride = workgroupStride;
         return t;
     }
 };
+
+bool ComputeRenderer::interleaves(const PixelWindow& area) {
+    return (area.width() > kMaxTileSide || area.height() > kMaxTileSide) && area.width() <= kMaxInterleavedSide &&
+           area.height() <= kMaxInterleavedSide;
+}
+
+std::vector<RenderRegion> ComputeRenderer::tiles(const PixelWindow& area, bool interleaved) {
+    const TilePlan plan(area, interleaved);
+    const double areaPixels = double(area.width()) * area.height();
+    std::vector<RenderRegion> out;
+    for (int ty = 0; ty < plan.tilesY; ++ty)
+        for (int tx = 0; tx < plan.tilesX; ++tx) {
+            const gpu::TileParams t = plan.tile(tx, ty);
+            if (plan.interleaved)
+                out.push_back({area, double(t.width) * t.height / areaPixels});
+            else
+                out.push_back({{int(t.originX), int(t.originY), int(t.originX + t.width), int(t.originY + t.height)}, 1.0});
+        }
+    return out;
+}
 
 // A render in progress: the dispatches' times, the tiles finished and their
 // rays (the tile in progress adds its invocations' counts), the truncation.
@@ -447,12 +497,7 @@ struct ComputeRenderer::Progress {
 
 ComputeRenderer::TilePlan ComputeRenderer::planTiles(const RenderRequest& request,
                                                      const Specialisation& values) const {
-    TilePlan plan;
-    plan.area = request.area();
-    plan.tileWidth = std::min(kMaxTileSide, plan.area.width());
-    plan.tileHeight = std::min(kMaxTileSide, plan.area.height());
-    plan.tilesX = (plan.area.width() + plan.tileWidth - 1) / plan.tileWidth;
-    plan.tilesY = (plan.area.height() + plan.tileHeight - 1) / plan.tileHeight;
+    TilePlan plan(request.area(), request.interleavedTiles);
     // Persistent invocations (trace.comp): on a CPU device a few workgroups
     // per core keep every core busy to the end of the dispatch; on a GPU
     // one per pixel, as many as the memory for their ray stacks allows.
@@ -634,7 +679,8 @@ void ComputeRenderer::expectTileCost(const RenderRequest& request, const TilePla
     for (std::uint64_t r = 0; r < runs; ++r) {
         double cost = 0.0;
         for (std::uint64_t k = r * run; k < std::min(pixels, (r + 1) * run); ++k)
-            cost += map.at(int(tile.originX + k % tile.width), int(tile.originY + k / tile.width));
+            cost += map.at(imageColumn(tile, std::uint32_t(k % tile.width)),
+                           imageRow(tile, std::uint32_t(k / tile.width)));
         std::vector<double>& before = progress.costBefore[r % workgroups];
         before.push_back(before.back() + cost);
         progress.sharePixels[r % workgroups] += std::min(run, pixels - r * run);
@@ -786,25 +832,24 @@ void ComputeRenderer::readBackTile(const Pipeline& p, const RenderRequest& reque
     TruncationReport& truncation = progress.truncation;
     const auto* pixels = static_cast<const gpu::OutputPixel*>(p.output.mapped);
     for (std::uint32_t y = 0; y < tile.height; ++y) {
-        const int column = int(tile.originX) - area.x0, windowRow = int(tile.originY + y) - area.y0;
-        float* row = rows.pixel(column, windowRow - firstRow);
+        const int imageY = imageRow(tile, y), windowRow = imageY - area.y0;
+        float* row = rows.pixel(0, windowRow - firstRow);
         const gpu::OutputPixel* src = pixels + std::size_t(y) * tile.width;
-        const int imageY = int(tile.originY + y);
         for (std::uint32_t x = 0; x < tile.width; ++x) {
             const gpu::OutputPixel& out = src[x];
-            row[x * 3 + 0] = out.colour.r;
-            row[x * 3 + 1] = out.colour.g;
-            row[x * 3 + 2] = out.colour.b;
+            const int imageX = imageColumn(tile, x), column = imageX - area.x0;
+            row[column * 3 + 0] = out.colour.r;
+            row[column * 3 + 1] = out.colour.g;
+            row[column * 3 + 2] = out.colour.b;
             // The pixel's truncation bound, negative where not finite.
             const float bound = std::abs(out.colour.a);
-            const int imageX = int(tile.originX + x);
             truncation.addPixel(imageX, imageY, bound, out.colour.a < 0.0f, out.truncation.y != 0.0f);
             if (out.truncation.x >= 0.0f) truncation.addEstimate(out.truncation.x);
             if (out.truncation.z != 0.0f) ++truncation.overTolerance;
             if (request.boundImage)
-                (*request.boundImage)[std::size_t(windowRow) * area.width() + column + x] = bound;
+                (*request.boundImage)[std::size_t(windowRow) * area.width() + column] = bound;
             if (request.rayImage)
-                (*request.rayImage)[std::size_t(windowRow) * area.width() + column + x] = out.truncation.w;
+                (*request.rayImage)[std::size_t(windowRow) * area.width() + column] = out.truncation.w;
         }
     }
     result.readbackMs += msSince(readStart);
@@ -831,18 +876,20 @@ GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool count
         if (request.boundImage) request.boundImage->assign(std::size_t(area.width()) * area.height(), 0.0f);
         if (request.rayImage) request.rayImage->assign(std::size_t(area.width()) * area.height(), 0.0f);
         if (!request.rowSink) result.image = Image(area.width(), area.height());
-        // Streaming rows: one band of tile rows at a time.
-        Image band = request.rowSink ? Image(area.width(), plan.tileHeight) : Image();
+        // Streaming rows: a band at a time (TilePlan::bandRows).
+        const int bandRows = plan.bandRows();
+        Image band = request.rowSink ? Image(area.width(), bandRows) : Image();
         Progress progress;
         for (int ty = 0; ty < plan.tilesY; ++ty) {
-            const int bandRow = ty * plan.tileHeight;
+            const int bandRow = plan.interleaved ? 0 : ty * plan.tileHeight;
             for (int tx = 0; tx < plan.tilesX; ++tx) {
                 const gpu::TileParams tile = plan.tile(tx, ty);
                 dispatchTile(p, request, plan, tile, countRays, progress, result);
                 if (request.rowSink) readBackTile(p, request, plan, tile, band, bandRow, progress, result);
                 else readBackTile(p, request, plan, tile, result.image, 0, progress, result);
             }
-            if (request.rowSink) request.rowSink(band.rgb.data(), std::min(plan.tileHeight, area.height() - bandRow));
+            const bool bandDone = !plan.interleaved || ty + 1 == plan.tilesY;
+            if (request.rowSink && bandDone) request.rowSink(band.rgb.data(), std::min(bandRows, area.height() - bandRow));
         }
         if (request.truncation) *request.truncation = progress.truncation;
         result.tracedRays = progress.raysBefore;

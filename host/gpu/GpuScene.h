@@ -29,7 +29,7 @@ static_assert(sizeof(FrameParams) == 192 && offsetof(FrameParams, cornerDir) == 
               offsetof(FrameParams, bvhNodeCount) == 152 && offsetof(FrameParams, sampleCount) == 160 &&
               offsetof(FrameParams, minWeight) == 172 && offsetof(FrameParams, airEta) == 184);
 static_assert(sizeof(TileParams) == 32 && offsetof(TileParams, resume) == 16 &&
-              offsetof(TileParams, workgroupStride) == 20);
+              offsetof(TileParams, workgroupStride) == 20 && offsetof(TileParams, strideY) == 28);
 static_assert(sizeof(SlotState) == 176 && offsetof(SlotState, lost) == 32 && offsetof(SlotState, pixel) == 96 &&
               offsetof(SlotState, finished) == 108 && offsetof(SlotState, treeRays) == 112 &&
               offsetof(SlotState, rays) == 120 && offsetof(SlotState, frontierOld) == 136 &&

@@ -96,6 +96,16 @@ struct PixelWindow {
     int width() const { return x1 - x0; }
     int height() const { return y1 - y0; }
     bool empty() const { return x1 <= x0 || y1 <= y0; }
+    bool operator==(const PixelWindow&) const = default;
+};
+
+// A part of a render, as the progress bar's probe sees it (the regions of a
+// render in the order its renderer finishes them): `share` of the pixels of
+// `window`, spread evenly over it (a tile of every other row and column of
+// the window is a quarter of it; a block of rows, the whole of its window).
+struct RenderRegion {
+    PixelWindow window;
+    double share = 1.0;
 };
 
 // What each pixel of an image is expected to cost, on a grid `stride` times
@@ -136,6 +146,10 @@ struct RenderRequest {
     // have finished and have left (render/WorkgroupSchedule.h), not by its
     // pixels finished (cheap ones finish first).
     const CostMap* expectedCost = nullptr;
+    // GPU renderer: an image of a few tiles in interleaved tiles, each a fair
+    // sample of the whole, so the first tile's time forecasts the others'
+    // (ComputeRenderer::kMaxInterleavedSide); the image is the same.
+    bool interleavedTiles = false;
     // Set to true from anywhere to stop early (the result is then incomplete).
     const std::atomic<bool>* cancel = nullptr;
     // When set, finished rows go here, top to bottom (width * 3 floats per
