@@ -70,8 +70,9 @@ public:
     // whole image, so the first tile's time forecasts the others' and the
     // progress bar's time left holds where cost is uneven over the image;
     // the image is streamed once all are done. Otherwise blocks, streamed a
-    // band of rows at a time. Interleaving cost cheap, even scenes 6–12 % and
-    // long renders nothing measurable (docs/performance.md).
+    // band of rows at a time. Interleaving cost 6–12 % where workgroups keep
+    // to their own shares (no refraction, no BVH), nothing measurable where
+    // they help each other (docs/performance.md).
     static constexpr int kMaxInterleavedSide = 2 * kMaxTileSide;
     static bool interleaves(const PixelWindow& area);
     // The tiles render() traces `area` in, in that order; its progress
