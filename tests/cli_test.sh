@@ -168,9 +168,18 @@ if command -v script >/dev/null; then
   grep -q "elapsed" "$work/tty" && grep -q "Mrays/s" "$work/tty" && [ -s "$work/prog.png" ] && ok ||
     bad "no progress bar on a terminal: $(tr '\r' '\n' <"$work/tty" | head -3)"
   # A render long enough for the bar to matter first estimates its rays from a
-  # sparse render of the same image (--verbose says how long that took).
+  # sparse render of the same image (--verbose says how long that took); one
+  # it expects to be short keeps its tiles in blocks (interleaved tiles cost
+  # a cheap scene more than its estimate gains).
   script -qfec "$SNELL render $SCENES/basic.scn --size 2048 -v -o $work/prog3.png" "$work/tty" >/dev/null 2>&1
   grep -q "estimate [0-9]* ms" "$work/tty" && [ -s "$work/prog3.png" ] && ok || bad "no ray estimate for the progress bar"
+  grep -q " 4 tiles, " "$work/tty" && ok || bad "a short render under the bar was not traced in 4 blocks: $(grep -a tiles "$work/tty")"
+  # A longer one may go in interleaved tiles (as its probe expects it to
+  # take): the image is the one rendered without the bar, whichever it is.
+  script -qfec "$SNELL render $SCENES/glass.scn --size 1100 -v -o $work/prog4.png" "$work/tty" >/dev/null 2>&1
+  "$SNELL" render "$SCENES/glass.scn" --size 1100 -q -o "$work/prog4-quiet.png" &&
+    cmp -s "$work/prog4.png" "$work/prog4-quiet.png" && ok ||
+    bad "the image under the progress bar differs ($(grep -a -o '[0-9]* [a-z ]*tiles' "$work/tty"))"
 fi
 "$SNELL" render "$SCENES/showcase.scn" --size 64 -o "$work/prog2.png" 2>"$work/err"; status=$?
 [ $status -eq 0 ] && [ -s "$work/prog2.png" ] && ! grep -q "elapsed" "$work/err" && ok ||

@@ -472,6 +472,7 @@ TEST(GpuTiles, InterleavedTilesGiveTheImageOfBlocks) {
         if (streamed) request.rowSink = [&](const float* rgb, int n) { rows.insert(rows.end(), rgb, rgb + n * window.width() * 3); };
         snell::GpuRenderResult result = gpu.render(request, false);
         EXPECT_EQ(result.tiles, 4);
+        EXPECT_EQ(result.interleaved, interleaved);
         out.image = std::move(result.image);
         if (streamed) out.image.rgb = rows;
         return out;

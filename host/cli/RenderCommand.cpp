@@ -102,6 +102,7 @@ struct RenderOutcome {
     double uploadMs = 0, pipelineMs = 0, renderMs = 0, readbackMs = 0;
     double estimateMs = 0;  // the progress bar's sparse render (estimateCost)
     int tiles = 0, dispatches = 0;
+    bool interleaved = false;  // interleaved tiles, else blocks (GPU)
     GpuRenderResult::Lanes lanes;
 };
 
@@ -304,13 +305,13 @@ int RenderCommand::run() {
     if (o_.verbose)
         std::fprintf(stderr,
                      "snell: %s: %dx%d, %s (%s) on %s\n"
-                     "snell: parse %.1f ms, upload %.1f ms, pipeline %.1f ms, render %.1f ms (%s, %d tiles, %d "
+                     "snell: parse %.1f ms, upload %.1f ms, pipeline %.1f ms, render %.1f ms (%s, %d %stiles, %d "
                      "dispatches), readback %.1f ms, write %.1f ms (%.1f ms of it not overlapped)%s; %.1f ms in all\n",
                      output.c_str(), request.width, request.height,
                      o_.cpu ? "CPU reference" : o_.device.precision.c_str(), outcome.traversal.c_str(),
                      outcome.device.c_str(), parseMs,
                      outcome.uploadMs, outcome.pipelineMs, outcome.renderMs, outcome.timing.c_str(), outcome.tiles,
-                     outcome.dispatches, outcome.readbackMs, stream.encodeMs(), stream.blockedMs(),
+                     outcome.interleaved ? "interleaved " : "", outcome.dispatches, outcome.readbackMs, stream.encodeMs(), stream.blockedMs(),
                      outcome.estimateMs > 0 ? (", estimate " + std::to_string(int(outcome.estimateMs)) + " ms").c_str() : "",
                      msSince(totalStart));
     if (o_.verbose && o_.countLanes && !o_.cpu)
@@ -447,6 +448,7 @@ RenderOutcome RenderCommand::renderOnGpu(const Scene& scene, RenderRequest& requ
         r.pipelineMs += g.pipelineMs;
         r.readbackMs = g.readbackMs;
         r.tiles = g.tiles;
+        r.interleaved = g.interleaved;
         r.dispatches = g.dispatches;
         r.lanes = g.lanes;
         r.timing = g.gpuTimed ? "gpu-timestamps" : "host";
@@ -489,7 +491,8 @@ std::string RenderCommand::statsJson(const Scene& scene, const RenderRequest& re
       << ", \"ellipsoids\": " << scene.ellipsoidCount() << ", \"lights\": " << scene.lights.size()
       << ", \"parse_ms\": " << parseMs << ", \"upload_ms\": " << r.uploadMs << ", \"pipeline_ms\": " << r.pipelineMs
       << ", \"render_ms\": " << r.renderMs << ", \"render_timing\": \"" << r.timing << "\""
-      << ", \"tiles\": " << r.tiles << ", \"dispatches\": " << r.dispatches << ", \"readback_ms\": " << r.readbackMs
+      << ", \"tiles\": " << r.tiles << ", \"interleaved_tiles\": " << (r.interleaved ? "true" : "false")
+      << ", \"dispatches\": " << r.dispatches << ", \"readback_ms\": " << r.readbackMs
       << ", \"write_ms\": " << stream.encodeMs() << ", \"write_wait_ms\": " << stream.blockedMs()
       << ", \"total_ms\": " << totalMs
       << ", \"rays\": {\"primary\": " << r.rays.primary << ", \"shadow\": " << r.rays.shadow

@@ -866,6 +866,7 @@ GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool count
         const Specialisation values = specialise(request, countRays);
         const TilePlan plan = planTiles(request, values);
         result.invocations = static_cast<int>(plan.invocations);
+        result.interleaved = plan.interleaved;
         bool created = false;
         Pipeline& p = ensurePipeline(values, created);
         ensureBuffers(p, request, plan);

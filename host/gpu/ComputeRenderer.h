@@ -25,6 +25,7 @@ struct GpuRenderResult {
     double pipelineMs = 0.0;  // shader pipeline creation
     double readbackMs = 0.0;  // copying tiles back into the image
     int tiles = 0;
+    bool interleaved = false;  // the tiles interleaved (RenderRequest::interleavedTiles), else blocks
     int dispatches = 0;       // more than one a tile where the driver limits loops (shared_layout.h)
     int invocations = 0;      // persistent invocations a dispatch (trace.comp)
     std::uint32_t rayStack = 0;        // entries of each invocation's ray stack
