@@ -109,7 +109,9 @@ using uint = std::uint32_t;
 // After them, for workgroup w at SNELL_COUNTER_COUNT + w · SNELL_COUNTER_STRIDE
 // (a cache line each), the pixels of its share of the tile its invocations
 // have taken after their first (trace.comp, takePixel); kept across the
-// dispatches that resume a tile.
+// dispatches that resume a tile. After those, a bit a share, set while it
+// may have pixels left, and then a bit a word of those, set while the word is
+// not 0 (the host sets them all at the tile's first dispatch).
 #define SNELL_COUNTER_STRIDE 16
 
 // Mesa's llvmpipe before 24 (lavapipe in Debian 12's Mesa 22.3) ends every

@@ -76,7 +76,8 @@ layout(constant_id = SNELL_SPEC_SHADOWS) const bool SHADOWS = true;
 // an imageStore in a loop costs 13x a buffer store; rgb the colour, a the
 // pixel's truncation bound), and its own bookkeeping.
 layout(set = 0, binding = SNELL_BINDING_OUTPUT, std430) writeonly buffer OutputBlock { OutputPixel outputPixels[]; };
-layout(set = 0, binding = SNELL_BINDING_COUNTERS, std430) buffer CounterBlock { uint counters[]; };
+// coherent: the shares' bits are read while other invocations clear them.
+layout(set = 0, binding = SNELL_BINDING_COUNTERS, std430) coherent buffer CounterBlock { uint counters[]; };
 #include "loop_budget.glsl"  // (it reports through the counters)
 layout(set = 0, binding = SNELL_BINDING_SLOT_STATES, std430) buffer SlotStateBlock { SlotState slotStates[]; };
 layout(set = 0, binding = SNELL_BINDING_RAY_STACK, std430) buffer RayStackBlock { PendingRay rayStack[]; };
@@ -668,12 +669,13 @@ bool spawnChildren(uint slot, inout SlotState state, inout Ray r, vec3 weight, H
             refracted = normalize(eta * d + (eta * c - sqrt(k)) * n);
         }
     }
-    float cut = tracingCutOff(state, cutOff);
-    bool reflects = (HAS_REFLECTION || HAS_REFRACTION) && worthTracing(reflectedWeight, cut);
-    bool refracts = transmits && worthTracing(transmittedWeight, cut);
+    bool reflects = (HAS_REFLECTION || HAS_REFRACTION) && worthTracing(reflectedWeight, tracingCutOff(state, cutOff));
     Ray reflectedRay = Ray(h.point, d - 2.0 * dot(d, n) * n, reflectedWeight, r.depth + 1u, h.sphere, !h.fromOutside,
                            r.mediaCount, 0u);
     if (!reflects && (HAS_REFLECTION || HAS_REFRACTION)) deferRay(slot, state, reflectedRay);
+    // Asked after the reflected child waits: should it have filled the
+    // frontier, the refracted child is traced down to the floor, not lost.
+    bool refracts = transmits && worthTracing(transmittedWeight, tracingCutOff(state, cutOff));
     if (reflects && COUNT_RAYS) countedRays[SNELL_COUNTER_REFLECTED]++;
     if (refracts && COUNT_RAYS) countedRays[SNELL_COUNTER_REFRACTED]++;
     if (!transmits) {
@@ -814,13 +816,63 @@ uint takeFromHelpedShare() {
     uint taken = atomicAdd(counters[SNELL_COUNTER_COUNT + helpedShare * SNELL_COUNTER_STRIDE], 1u);
     return taken / size * invocations + helpedShare * size + taken % size;
 }
+// Which shares may have pixels left, as bits (shared_layout.h): a bit a
+// share, and above them a bit a word of those, set while the word is not 0.
+// They spare a helper an atomic on every share taken: on a GPU, thousands of
+// workgroups each walking thousands of shares cost more than the tile.
+uint shareWords() { return (gl_NumWorkGroups.x + 31u) / 32u; }
+// The counter holding share s's bit, and that holding share word w's bit.
+uint shareBitsAt(uint s) { return SNELL_COUNTER_COUNT + gl_NumWorkGroups.x * SNELL_COUNTER_STRIDE + s / 32u; }
+uint wordBitsAt(uint w) { return SNELL_COUNTER_COUNT + gl_NumWorkGroups.x * SNELL_COUNTER_STRIDE + shareWords() + w / 32u; }
+// Share s has no pixel left: its bit cleared, and its word's once that is 0
+// (the clear that empties a word is the one that sees it go).
+void shareTaken(uint s) {
+    uint old = atomicAnd(counters[shareBitsAt(s)], ~(1u << (s % 32u)));
+    if (old == 1u << (s % 32u)) atomicAnd(counters[wordBitsAt(s / 32u)], ~(1u << (s / 32u % 32u)));
+}
+// The first share word at or after word w, in turn, whose bit is set; NONE where none is.
+uint nextWordLeft(uint w) {
+    const uint count = (shareWords() + 31u) / 32u;
+    uint k = w / 32u;
+    uint bits = counters[wordBitsAt(w)] & ~((1u << (w % 32u)) - 1u);
+    for (uint n = 0u; n <= count; ++n) {
+        tick(1u);
+        if (bits != 0u) return k * 32u + uint(findLSB(bits));
+        k = k + 1u == count ? 0u : k + 1u;
+        bits = counters[wordBitsAt(k * 32u)];
+    }
+    return NONE;
+}
+// The next share after s, in turn, that may have pixels left; NONE where none has.
+uint nextShareLeft(uint s) {
+    uint rest = counters[shareBitsAt(s)] & ~((2u << (s % 32u)) - 1u);
+    if (rest != 0u) return s / 32u * 32u + uint(findLSB(rest));
+    const uint words = shareWords();
+    uint w = s / 32u;
+    for (uint n = 0u; n <= words; ++n) {
+        tick(1u);
+        w = nextWordLeft(w + 1u == words ? 0u : w + 1u);
+        if (w == NONE) return NONE;
+        uint bits = counters[shareBitsAt(w * 32u)];
+        if (bits != 0u) return w * 32u + uint(findLSB(bits));
+        // Emptied since its word's bit was read: on past it.
+    }
+    return NONE;
+}
 uint takePixel() {
     uint pixel = takeFromHelpedShare();
-    for (uint k = 1u; k < (HELPS ? gl_NumWorkGroups.x : 1u) && pixel >= tilePixels; ++k) {
-        helpedShare = helpedShare + 1u == gl_NumWorkGroups.x ? 0u : helpedShare + 1u;
+    if (!HELPS) return min(pixel, tilePixels);
+    // Each failed take clears its share's bit, and bits are only cleared, so
+    // this ends. These loops count towards the loop budget like the others.
+    while (pixel >= tilePixels) {
+        tick(1u);
+        shareTaken(helpedShare);
+        uint next = nextShareLeft(helpedShare);
+        if (next == NONE) return tilePixels;
+        helpedShare = next;
         pixel = takeFromHelpedShare();
     }
-    return min(pixel, tilePixels);
+    return pixel;
 }
 
 // The finished pixel written out (render/Truncation.h: its colour, bound and

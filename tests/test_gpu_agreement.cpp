@@ -16,6 +16,7 @@
 #include <gtest/gtest.h>
 
 #include "gpu/ComputeRenderer.h"
+#include "gpu/DriverProbe.h"
 #include "image/ImageIO.h"
 #include "metrics/ImageMetrics.h"
 #include "reference/CpuRenderer.h"
@@ -48,11 +49,15 @@ struct Case {
     bool noSpeckles = true;
     snell::gpu::Precision precision = snell::gpu::Precision::Fp32;
     snell::gpu::Traversal traversal = snell::gpu::Traversal::Walk;
+    // Planned as on a GPU (ComputeRenderer::planAsGpu): its short frontiers
+    // and thousands of workgroups sharing the tile, on lavapipe.
+    bool gpuPlan = false;
 };
 
 const char* suffix(const Case& c) {
     return c.precision == snell::gpu::Precision::Fp64        ? "_fp64"
            : c.traversal == snell::gpu::Traversal::RayQuery ? "_ray_query"
+           : c.gpuPlan                                       ? "_gpu_plan"
                                                               : "";
 }
 
@@ -72,6 +77,15 @@ std::vector<Case> allCases() {
         const std::string name = fs::path(p).stem().string();
         c.noSpeckles = p.find("/course-scenes/") == std::string::npos;
         cases.push_back(c);
+        // A GPU's plan where its paths differ from lavapipe's: refraction
+        // and BVH scenes (workgroups help with each other's shares), and a
+        // scene with traps (frontiers; at 32 entries there, a GPU's plan
+        // once lost the light of 87 pixels of glass-in-water-gap-0).
+        if (p.find("/course-scenes/") != std::string::npos || name == "glass" || name == "glass-in-water-gap-0") {
+            Case g = c;
+            g.gpuPlan = true;
+            cases.push_back(g);
+        }
         const bool hard = p.find("/scenes/hard/") != std::string::npos;
         if (hard) {
             Case fp64 = c;
@@ -169,11 +183,19 @@ TEST_P(GpuAgreement, MatchesCpuReference) {
         }
         return;
     }
+    if (c.precision == snell::gpu::Precision::Fp64 && !context().fp64Refusal().empty()) {
+        // A driver the fp64 shader renders wrong on refuses it, saying why.
+        EXPECT_THROW(snell::ComputeRenderer(context(), scene, request.camera, c.precision, snell::gpu::BvhMode::Auto,
+                                            c.traversal),
+                     snell::vk::VulkanError);
+        return;
+    }
     snell::ComputeRenderer gpuRenderer(context(), scene, request.camera, c.precision, snell::gpu::BvhMode::Auto,
                                        c.traversal);
     const bool bvh = scene.spheres.size() > snell::gpu::kBvhThreshold;
     EXPECT_STREQ(gpuRenderer.traversal(),
                  c.traversal == snell::gpu::Traversal::RayQuery ? "ray-query" : bvh ? "bvh" : "loop");
+    gpuRenderer.planAsGpu(c.gpuPlan);
     const snell::GpuRenderResult gpu = gpuRenderer.render(request, false);
     EXPECT_EQ(context().validationMessages(), messagesBefore) << "the Vulkan validation layer reported messages";
 
@@ -492,3 +514,40 @@ TEST(GpuTiles, InterleavedTilesGiveTheImageOfBlocks) {
 }
 
 }  // namespace
+
+// A GPU's plan (thousands of workgroups taking the tile's shares, helping
+// with each other's through the shares' bits, their words' bits over more
+// than one word) traces each pixel as lavapipe's plan does: the same image
+// for a fixed tree. (Under a tolerance a GPU's shorter frontier traces some
+// rays a step early, so the trees, and the last bits, may differ.) On a
+// driver that limits loops (Mesa 22.3), where the GPU's plan suspends its
+// invocations at other points, 3 of grid's 262 144 pixels differed in their
+// last bits, cause not established: there a handful may.
+constexpr std::size_t kLoopLimitedDifferences = 16;
+TEST(GpuPlan, TracesTheImageOfLavapipesPlan) {
+    for (const char* file : {SNELL_SOURCE_DIR "/scenes/grid.scn", SNELL_SOURCE_DIR "/scenes/glass.scn"}) {
+        SCOPED_TRACE(file);
+        const snell::Scene scene = snell::parseSceneFile(file);
+        snell::RenderRequest request;
+        request.width = request.height = 512;
+        request.camera = snell::Camera::fromSpec(512, scene.halfWidth);
+        request.trace = snell::kDefaultSettings;
+        request.trace.tolerance = 0.0;
+        snell::ComputeRenderer gpu(context(), scene, request.camera);
+        const snell::GpuRenderResult own = gpu.render(request, false);
+        gpu.planAsGpu(true);
+        const snell::GpuRenderResult planned = gpu.render(request, false);
+        if (context().isCpuDevice()) {
+            EXPECT_LT(own.invocations, planned.invocations);
+            // grid: more shares than 32 words of bits, so the words' bits span words too.
+            if (scene.spheres.size() > snell::gpu::kBvhThreshold)
+                EXPECT_GT(planned.invocations, 32 * 32 * SNELL_WORKGROUP_SIZE);
+        }
+        ASSERT_EQ(planned.image.rgb.size(), own.image.rgb.size());
+        std::size_t differ = 0;
+        for (std::size_t i = 0; i < own.image.rgb.size(); i += 3)
+            differ += !std::equal(&own.image.rgb[i], &own.image.rgb[i] + 3, &planned.image.rgb[i]);
+        EXPECT_LE(differ, snell::limitsLoopIterations(context()) ? kLoopLimitedDifferences : 0u)
+            << "pixels that differ between the plans";
+    }
+}

@@ -142,7 +142,8 @@ TEST_P(IntersectFuzz, AgainstDouble) {
 
     snell::vk::Buffer input = context.createBufferWithData(cases.data(), cases.size() * sizeof cases[0],
                                                            VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
-    snell::vk::Buffer output = context.createBuffer(kCases * sizeof(glm::vec4), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true);
+    snell::vk::Buffer output = context.createBuffer(kCases * sizeof(glm::vec4), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT,
+                                                    snell::vk::Context::Memory::HostCached);
     {
         snell::vk::ComputeKernel kernel(context, bounds.spirv, bounds.spirvBytes, 2);
         kernel.run({&input, &output}, nullptr, (kCases + SNELL_KERNEL_GROUP_SIZE - 1) / SNELL_KERNEL_GROUP_SIZE);

@@ -150,7 +150,7 @@ Ceiling measureCeiling(vk::Context& context, int runs, bool quick) {
     const std::uint32_t rays = quick ? (1u << 18) : (1u << 20);
     vk::Buffer input = context.createBufferWithData(spheres.data(), spheres.size() * sizeof spheres[0],
                                                     VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
-    vk::Buffer output = context.createBuffer(rays * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, false);
+    vk::Buffer output = context.createBuffer(rays * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::Context::Memory::Device);
     Ceiling c;
     try {
         for (int form = 0; form < 2; ++form) {
@@ -175,7 +175,7 @@ Ceiling measureCeiling(vk::Context& context, int runs, bool quick) {
     // The floor.
     c.floorSize = quick ? 256 : 1024;
     const std::uint32_t pixels = std::uint32_t(c.floorSize) * std::uint32_t(c.floorSize);
-    vk::Buffer image = context.createBuffer(VkDeviceSize(pixels) * 16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, false);
+    vk::Buffer image = context.createBuffer(VkDeviceSize(pixels) * 16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::Context::Memory::Device);
     try {
         vk::ComputeKernel kernel(context, snell_store_kernel_comp_spv, sizeof snell_store_kernel_comp_spv, 1);
         kernel.run({&image}, nullptr, pixels / SNELL_KERNEL_GROUP_SIZE);
@@ -200,7 +200,7 @@ Ceiling measureCeiling(vk::Context& context, int runs, bool quick) {
 }
 
 
-std::vector<Setting> settingsFor(const Scene& scene, bool quick) {
+std::vector<Setting> settingsFor(const Scene& scene, bool quick, bool fp64) {
     std::vector<Setting> s;
     s.push_back({"default"});
     // Depth alone (no cut-off): at most 2^depth rays a pixel, so it stays small.
@@ -233,9 +233,12 @@ std::vector<Setting> settingsFor(const Scene& scene, bool quick) {
         x.tolerance = 0.0;
         s.push_back(x);
     }
-    Setting fp64{"fp64"};
-    fp64.precision = gpu::Precision::Fp64;
-    s.push_back(fp64);
+    // Where the device renders fp64 (Context::fp64Refusal).
+    if (fp64) {
+        Setting wide{"fp64"};
+        wide.precision = gpu::Precision::Fp64;
+        s.push_back(wide);
+    }
     if (scene.spheres.size() > 1) {
         const bool autoUsesBvh = scene.spheres.size() > gpu::kBvhThreshold;
         Setting flip{autoUsesBvh ? "BVH off" : "BVH on"};
@@ -760,7 +763,8 @@ void benchScene(vk::Context& context, const BenchOptions& o, const SceneFile& fi
 
     SceneRun run{context, scene, name, file.group, base, exact, runs, o.quick, o.cancel, {}};
     const std::size_t def = out.results.size();
-    for (const Setting& setting : settingsFor(scene, o.quick)) out.results.push_back(run.measure(setting));
+    const bool fp64 = context.float64Supported() && context.fp64Refusal().empty();
+    for (const Setting& setting : settingsFor(scene, o.quick, fp64)) out.results.push_back(run.measure(setting));
     {
         const Result& d = out.results[def];
         log << name << ": default " << number(d.dispatchMs.median) << " ms, error " << number(d.error.meanAbsError)

@@ -27,7 +27,8 @@ public:
         for (const auto& r : reports)
             std::cout << r.index << ": " << r.name << " (" << r.type << ", " << r.driver << ")"
                       << (r.usable ? "" : " — unusable: " + r.reason)
-                      << (r.usable ? traversal(r) : "") << "\n";
+                      << (r.usable ? traversal(r) : "")
+                      << (r.usable && !r.fp64Refusal.empty() ? "; no --precision fp64: " + r.fp64Refusal : "") << "\n";
         return kExitSuccess;
     }
 };

@@ -102,6 +102,7 @@ struct RenderOutcome {
     double uploadMs = 0, pipelineMs = 0, renderMs = 0, readbackMs = 0;
     double estimateMs = 0;  // the progress bar's sparse render (estimateCost)
     int tiles = 0, dispatches = 0;
+    int invocations = 0;  // persistent invocations a dispatch (GPU)
     bool interleaved = false;  // interleaved tiles, else blocks (GPU)
     GpuRenderResult::Lanes lanes;
 };
@@ -450,6 +451,7 @@ RenderOutcome RenderCommand::renderOnGpu(const Scene& scene, RenderRequest& requ
         r.tiles = g.tiles;
         r.interleaved = g.interleaved;
         r.dispatches = g.dispatches;
+        r.invocations = g.invocations;
         r.lanes = g.lanes;
         r.timing = g.gpuTimed ? "gpu-timestamps" : "host";
         if (g.stackOverflows > 0 && !o_.quiet)
@@ -492,7 +494,7 @@ std::string RenderCommand::statsJson(const Scene& scene, const RenderRequest& re
       << ", \"parse_ms\": " << parseMs << ", \"upload_ms\": " << r.uploadMs << ", \"pipeline_ms\": " << r.pipelineMs
       << ", \"render_ms\": " << r.renderMs << ", \"render_timing\": \"" << r.timing << "\""
       << ", \"tiles\": " << r.tiles << ", \"interleaved_tiles\": " << (r.interleaved ? "true" : "false")
-      << ", \"dispatches\": " << r.dispatches << ", \"readback_ms\": " << r.readbackMs
+      << ", \"dispatches\": " << r.dispatches << ", \"invocations\": " << r.invocations << ", \"readback_ms\": " << r.readbackMs
       << ", \"write_ms\": " << stream.encodeMs() << ", \"write_wait_ms\": " << stream.blockedMs()
       << ", \"total_ms\": " << totalMs
       << ", \"rays\": {\"primary\": " << r.rays.primary << ", \"shadow\": " << r.rays.shadow

@@ -78,6 +78,9 @@ ComputeRenderer::ComputeRenderer(vk::Context& context, const Scene& scene, const
         throw vk::VulkanError("--precision fp64 needs shader doubles (the shaderFloat64 feature), which " +
                               std::string(context.properties().deviceName) +
                               " lacks; use --precision fp32, or another device (--gpu; lavapipe has them)");
+    if (precision == gpu::Precision::Fp64 && !context.fp64Refusal().empty())
+        throw vk::VulkanError("--precision fp64: " + context.fp64Refusal() +
+                              "; use --precision fp32, --cpu (double precision), or lavapipe (--gpu)");
     if (traversal == gpu::Traversal::RayQuery) {
         if (precision == gpu::Precision::Fp64)
             throw vk::VulkanError("--traversal ray-query traces in fp32: it cannot be combined with --precision fp64");
@@ -178,9 +181,14 @@ namespace {
 // cut-off) the depth limit bounds k, up to kMaxRayStack; past that the
 // shader drops the child that would wait and counts it (SNELL_COUNTER_OVERFLOW).
 constexpr std::uint32_t kMaxRayStack = 256;
+
 // Frontier entries an invocation keeps (trace.comp, deferRay). On a CPU device
 // there are few invocations (a few workgroups a core) and room for many; a GPU
-// needs its invocations more than long frontiers.
+// needs its invocations more than long frontiers, except in a scene with
+// traps, whose pixels go on below the floor from what waits there: a ray
+// lost to a full frontier may be light that would have grown. At 32 entries
+// glass-in-water-gap-0 at 128² lost the light of 87 pixels (off by up to
+// 207/255 where the reference saturates); at 512, none.
 constexpr std::uint32_t kCpuFrontier = 512;
 constexpr std::uint32_t kGpuFrontier = 32;
 std::uint32_t rayStackEntries(const Scene& scene, const TraceSettings& trace, bool reflection) {
@@ -236,7 +244,7 @@ ComputeRenderer::Specialisation ComputeRenderer::specialise(const RenderRequest&
     const bool secondaryRays = hasRefraction || hasReflection;
     values[SNELL_SPEC_FRONTIER] =
         request.trace.tolerance > 0.0 && secondaryRays
-            ? (context_.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU ? kCpuFrontier : kGpuFrontier)
+            ? (plansForCpu() || layout_.traps ? kCpuFrontier : kGpuFrontier)
             : 0u;
     values[SNELL_SPEC_LOOP_BUDGET] = loopBudget_;
     values[SNELL_SPEC_COUNT_LANES] = countLanes_;
@@ -369,13 +377,29 @@ void memoryBarrier(VkCommandBuffer cmd, VkAccessFlags srcAccess, VkAccessFlags d
     vkCmdPipelineBarrier(cmd, srcStage, dstStage, 0, 1, &b, 0, nullptr, 0, nullptr);
 }
 
-// The dispatch's counters and then each workgroup's (shared_layout.h).
+// The dispatch's counters, then each workgroup's, then the bits of the
+// shares with pixels left and those of their words (shared_layout.h).
+std::size_t shareBitsAt(std::uint64_t workgroups) { return SNELL_COUNTER_COUNT + workgroups * SNELL_COUNTER_STRIDE; }
+std::size_t shareWords(std::uint64_t workgroups) { return (workgroups + 31) / 32; }
 std::size_t counterCount(std::uint64_t workgroups) {
-    return SNELL_COUNTER_COUNT + workgroups * SNELL_COUNTER_STRIDE;
+    return shareBitsAt(workgroups) + shareWords(workgroups) + (shareWords(workgroups) + 31) / 32;
+}
+// Bits 0..n-1 set in words from counters[at] on.
+void setBits(std::uint32_t* counters, std::size_t at, std::uint64_t n) {
+    for (std::uint64_t i = 0; i < n; i += 32) counters[at + i / 32] = n - i >= 32 ? ~0u : (1u << (n - i)) - 1u;
 }
 
-// Device memory for the invocations' ray stacks.
+// Device memory for the invocations' ray stacks: 64 MiB on a CPU device; on
+// a GPU a sixteenth of its memory, up to 1 GiB, for up to kGpuInvocations
+// invocations. On an H200 at 2048², 64 MiB left SphereFlake2 (8.5 KB of
+// stack an invocation at --depth 64) 7 872 invocations and took 1590 ms,
+// 1 GiB 126 336 and 735 ms; showcase took 42 ms with 2^18 invocations and
+// 212 with a million (every pixel of the tile its own), tir 78 and 344.
+// 2^18 fills an H200 (132 multiprocessors of 2048 threads). (Where it
+// lost: scenes/glass 20.7 → 38.2 ms with 13 000 → 210 000; docs/performance.md.)
 constexpr VkDeviceSize kStackBudget = 64ull << 20;
+constexpr VkDeviceSize kGpuStackBudget = 1ull << 30;
+constexpr VkDeviceSize kGpuInvocations = 1ull << 18;
 // Workgroups of persistent invocations per core on a CPU device (lavapipe):
 // enough that the cores finish together.
 constexpr unsigned kCpuWorkgroupsPerCore = 8;
@@ -500,23 +524,27 @@ ComputeRenderer::TilePlan ComputeRenderer::planTiles(const RenderRequest& reques
     TilePlan plan(request.area(), request.interleavedTiles);
     // Persistent invocations (trace.comp): on a CPU device a few workgroups
     // per core keep every core busy to the end of the dispatch; on a GPU
-    // one per pixel, as many as the memory for their ray stacks allows.
+    // enough to fill it, as many as the memory for their ray stacks allows.
     const bool wide = layout_.precision == gpu::Precision::Fp64;  // a low part per pending ray too
     const VkDeviceSize rayEntries = VkDeviceSize(values[SNELL_SPEC_RAY_STACK]) + values[SNELL_SPEC_FRONTIER];
     const VkDeviceSize bytesPerSlot =
         sizeof(gpu::SlotState) +
         rayEntries * ((wide ? 2 : 1) * sizeof(gpu::PendingRay) + values[SNELL_SPEC_MAX_MEDIA] * 4);
     const VkDeviceSize limit = context_.properties().limits.maxStorageBufferRange;
-    VkDeviceSize slots = std::min(kStackBudget, limit) / bytesPerSlot;
-    if (context_.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU)
+    const bool cpu = plansForCpu();
+    VkDeviceSize budget = cpu ? kStackBudget : std::clamp(context_.deviceLocalBytes() / 16, kStackBudget, kGpuStackBudget);
+    VkDeviceSize slots = std::min(budget, limit) / bytesPerSlot;
+    if (cpu)
         slots = std::min<VkDeviceSize>(slots, SNELL_WORKGROUP_SIZE * kCpuWorkgroupsPerCore *
                                                   std::max(1u, std::thread::hardware_concurrency()));
+    else
+        slots = std::min(slots, kGpuInvocations);
     plan.invocations =
         std::clamp<VkDeviceSize>(std::min(slots, plan.tilePixels()) / SNELL_WORKGROUP_SIZE, 1, 65535) *
         SNELL_WORKGROUP_SIZE;
     // lavapipe gives each thread a contiguous range of workgroups: the shares
     // of neighbouring workgroups are spread over the tile (trace.comp, share).
-    if (context_.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU)
+    if (cpu)
         plan.workgroupStride = spreadingStride(std::uint32_t(plan.workgroups()));
     plan.helps = values[SNELL_SPEC_HELPS] != 0;
     return plan;
@@ -546,20 +574,24 @@ void ComputeRenderer::ensureBuffers(Pipeline& p, const RenderRequest& request, c
             context_.destroy(*b);
         const VkDeviceSize slots = plan.invocations;
         p.slots = slots;
+        // Mapped: the host reads the invocations' progress while they run.
+        // The counters device-local where they can be: every pixel taken is
+        // an atomic on one, which on a discrete GPU would cross the bus.
+        using Memory = vk::Context::Memory;
         p.counters = context_.createBuffer(counterCount(slots / SNELL_WORKGROUP_SIZE) * sizeof(std::uint32_t),
-                                           kStorage, true);
-        // Host-visible: the host reads the invocations' progress while they run.
-        p.slotStates = context_.createBuffer(slots * sizeof(gpu::SlotState), kStorage, true);
-        p.rayStack = context_.createBuffer(slots * p.rayEntries * sizeof(gpu::PendingRay), kStorage, false);
-        p.mediaStack = context_.createBuffer(slots * p.rayEntries * p.maxMedia * 4, kStorage, false);
-        if (wide) p.rayStackLow = context_.createBuffer(slots * p.rayEntries * sizeof(gpu::PendingRay), kStorage, false);
+                                           kStorage, Memory::DeviceMapped);
+        p.slotStates = context_.createBuffer(slots * sizeof(gpu::SlotState), kStorage, Memory::HostCached);
+        p.rayStack = context_.createBuffer(slots * p.rayEntries * sizeof(gpu::PendingRay), kStorage, Memory::Device);
+        p.mediaStack = context_.createBuffer(slots * p.rayEntries * p.maxMedia * 4, kStorage, Memory::Device);
+        if (wide)
+            p.rayStackLow = context_.createBuffer(slots * p.rayEntries * sizeof(gpu::PendingRay), kStorage, Memory::Device);
     }
     if (plan.tilePixels() > p.tilePixels) {
         context_.destroy(p.output);
         p.tilePixels = plan.tilePixels();
         // The tile's pixels, which the host reads where the shader wrote them
         // (on lavapipe, an imageStore in a loop costs 13x a buffer store).
-        p.output = context_.createBuffer(p.tilePixels * sizeof(gpu::OutputPixel), kStorage, true);
+        p.output = context_.createBuffer(p.tilePixels * sizeof(gpu::OutputPixel), kStorage, vk::Context::Memory::HostCached);
     }
 
     std::array<VkDescriptorBufferInfo, SNELL_BINDING_ACCELERATION + 1> bufferInfo{};
@@ -784,6 +816,10 @@ void ComputeRenderer::dispatchTile(Pipeline& p, const RenderRequest& request, co
         if (request.cancel && request.cancel->load()) throw vk::VulkanError("render cancelled");
         // A resumed dispatch goes on taking the workgroups' pixels where the last one stopped.
         std::memset(counters, 0, (pass > 0 ? SNELL_COUNTER_COUNT : counterCount(groups)) * sizeof(std::uint32_t));
+        if (pass == 0) {
+            setBits(counters, shareBitsAt(groups), groups);
+            setBits(counters, shareBitsAt(groups) + shareWords(groups), shareWords(groups));
+        }
         tile.resume = pass > 0 ? 1u : 0u;
         if (pass == 0) std::memset(p.slotStates.mapped, 0, plan.invocations * sizeof(gpu::SlotState));
         submit(p, progress, true, pass > 0, [&](VkCommandBuffer cmd) {

@@ -87,6 +87,11 @@ public:
     void forceLoopBudget(std::uint32_t budget) { loopBudget_ = budget; }
     // Measuring: count the lanes busy in each loop pass (GpuRenderResult::lanes; slower).
     void countLanes(bool count) { countLanes_ = count; }
+    // Testing: plan as for a GPU (its invocations, frontiers and shares) on a
+    // CPU device, so lavapipe runs the paths a GPU takes. A fixed tree's
+    // image must not change; under a tolerance the shorter frontiers may
+    // trace some rays a step early, within the bounds.
+    void planAsGpu(bool asGpu) { planAsGpu_ = asGpu; }
 
 private:
     struct Pipeline;
@@ -122,6 +127,8 @@ private:
     // The scene's buffers, by binding (shared_layout.h); the others stay empty.
     std::array<vk::Buffer, SNELL_BINDING_COUNT> sceneBuffers_{};
     std::array<VkBufferView, SNELL_BINDING_COUNT> sceneViews_{};
+    bool plansForCpu() const { return context_.isCpuDevice() && !planAsGpu_; }
+    bool planAsGpu_ = false;
     std::uint32_t loopBudget_ = 0;  // where the driver ends long loops (gpu/DriverProbe.h), else 0
     bool countLanes_ = false;
     double uploadMs_ = 0.0;

@@ -20,7 +20,7 @@ bool limitsLoopIterations(vk::Context& context) {
     if (auto it = probed.find(key); it != probed.end()) return it->second;
 
     const std::uint32_t iterations = 2 * SNELL_DRIVER_LOOP_LIMIT;
-    vk::Buffer result = context.createBuffer(sizeof(std::uint32_t), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true);
+    vk::Buffer result = context.createBuffer(sizeof(std::uint32_t), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::Context::Memory::HostCached);
     std::uint32_t passes = 0;
     try {
         vk::ComputeKernel kernel(context, snell_loop_limit_probe_comp_spv, sizeof snell_loop_limit_probe_comp_spv, 1,

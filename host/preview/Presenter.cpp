@@ -158,7 +158,7 @@ void Presenter::ensureSource(int width, int height) {
     context_.destroy(staging_);
     source_ = context_.createImage(width, height, VK_FORMAT_R8G8B8A8_UNORM,
                                    VK_IMAGE_USAGE_TRANSFER_DST_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT);
-    staging_ = context_.createBuffer(VkDeviceSize(width) * height * 4, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true);
+    staging_ = context_.createBuffer(VkDeviceSize(width) * height * 4, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, vk::Context::Memory::HostCached);
 }
 
 bool Presenter::present(const std::vector<std::uint8_t>& rgba, int width, int height) {

@@ -85,7 +85,7 @@ VkAccelerationStructureKHR BoxAccelerationStructure::build(const VkAccelerationS
     storage = context_.createBuffer(sizes.accelerationStructureSize,
                                     VK_BUFFER_USAGE_ACCELERATION_STRUCTURE_STORAGE_BIT_KHR |
                                         VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT,
-                                    false);
+                                    Context::Memory::Device);
     VkAccelerationStructureCreateInfoKHR create{VK_STRUCTURE_TYPE_ACCELERATION_STRUCTURE_CREATE_INFO_KHR};
     create.buffer = storage.buffer;
     create.size = sizes.accelerationStructureSize;
@@ -103,7 +103,7 @@ VkAccelerationStructureKHR BoxAccelerationStructure::build(const VkAccelerationS
     try {
         scratch = context_.createBuffer(sizes.buildScratchSize + align,
                                         VK_BUFFER_USAGE_STORAGE_BUFFER_BIT | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT,
-                                        false);
+                                        Context::Memory::Device);
         info.dstAccelerationStructure = structure;
         info.scratchData.deviceAddress = (context_.deviceAddress(scratch) + align - 1) / align * align;
         VkAccelerationStructureBuildRangeInfoKHR range{};

@@ -142,6 +142,7 @@ DeviceReport examine(VkPhysicalDevice device, int index, std::uint32_t& family,
     report.usable = true;
     std::string ignored;
     report.rayQueries = supportsRayQueries(device, ignored);
+    report.fp64Refusal = Context::fp64RefusalFor(driver.driverID);
     return report;
 }
 
@@ -498,6 +499,24 @@ VKAPI_ATTR VkBool32 VKAPI_CALL Context::debugCallback(VkDebugUtilsMessageSeverit
     return VK_FALSE;
 }
 
+std::string Context::fp64RefusalFor(VkDriverId driver) {
+    // On an H200 with NVIDIA's driver 580.159 every fp64 agreement test
+    // failed (up to every pixel wrong), each differently as the shader's
+    // shape changed, while the fp64 intersection fuzz test passed there: the
+    // fp64 kernel is not to be trusted on it (docs/accuracy.md).
+    if (driver == VK_DRIVER_ID_NVIDIA_PROPRIETARY)
+        return "the fp64 shader renders wrong images on NVIDIA's driver (every fp64 agreement test failed on it)";
+    return "";
+}
+
+VkDeviceSize Context::deviceLocalBytes() const {
+    VkDeviceSize largest = 0;
+    for (std::uint32_t i = 0; i < memory_.memoryHeapCount; ++i)
+        if (memory_.memoryHeaps[i].flags & VK_MEMORY_HEAP_DEVICE_LOCAL_BIT)
+            largest = std::max(largest, memory_.memoryHeaps[i].size);
+    return largest;
+}
+
 std::uint32_t Context::findMemoryType(std::uint32_t typeBits, VkMemoryPropertyFlags required,
                                       VkMemoryPropertyFlags preferred) const {
     for (VkMemoryPropertyFlags want : {required | preferred, required}) {
@@ -508,7 +527,8 @@ std::uint32_t Context::findMemoryType(std::uint32_t typeBits, VkMemoryPropertyFl
     throw VulkanError("no suitable Vulkan memory type for a buffer or image");
 }
 
-Buffer Context::createBuffer(VkDeviceSize size, VkBufferUsageFlags usage, bool hostVisible) {
+Buffer Context::createBuffer(VkDeviceSize size, VkBufferUsageFlags usage, Memory memory) {
+    const bool hostVisible = memory != Memory::Device;
     Buffer b;
     b.size = std::max<VkDeviceSize>(size, 16);  // zero-sized buffers are invalid in Vulkan
     VkBufferCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO};
@@ -526,7 +546,8 @@ Buffer Context::createBuffer(VkDeviceSize size, VkBufferUsageFlags usage, bool h
     try {
         alloc.memoryTypeIndex = hostVisible
             ? findMemoryType(req.memoryTypeBits, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | VK_MEMORY_PROPERTY_HOST_COHERENT_BIT,
-                             VK_MEMORY_PROPERTY_HOST_CACHED_BIT)
+                             memory == Memory::DeviceMapped ? VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT
+                                                            : VK_MEMORY_PROPERTY_HOST_CACHED_BIT)
             : findMemoryType(req.memoryTypeBits, 0, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
         check(allocate(alloc, &b.memory), "vkAllocateMemory");
         check(vkBindBufferMemory(device_, b.buffer, b.memory, 0), "vkBindBufferMemory");
@@ -539,7 +560,7 @@ Buffer Context::createBuffer(VkDeviceSize size, VkBufferUsageFlags usage, bool h
 }
 
 Buffer Context::createBufferWithData(const void* bytes, VkDeviceSize size, VkBufferUsageFlags usage) {
-    Buffer target = createBuffer(size, usage | VK_BUFFER_USAGE_TRANSFER_DST_BIT, false);
+    Buffer target = createBuffer(size, usage | VK_BUFFER_USAGE_TRANSFER_DST_BIT, Memory::Device);
     if (size == 0) return target;
     // Device-local memory that the host can see (lavapipe, integrated GPUs, ReBAR) is written directly.
     VkMemoryRequirements req;
@@ -560,7 +581,7 @@ Buffer Context::createBufferWithData(const void* bytes, VkDeviceSize size, VkBuf
         vkUnmapMemory(device_, target.memory);
         return target;
     }
-    Buffer staging = createBuffer(size, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true);
+    Buffer staging = createBuffer(size, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, Memory::HostCached);
     std::memcpy(staging.mapped, bytes, size);
     try {
         submitAndWait([&](VkCommandBuffer cmd) {

@@ -77,6 +77,7 @@ struct DeviceReport {
     bool usable = false;
     std::string reason;  // why it was passed over, when it was
     bool rayQueries = false;  // has ray queries and acceleration structures
+    std::string fp64Refusal;  // why --precision fp64 is refused here, if it is (Context::fp64Refusal)
 };
 
 struct Buffer {
@@ -111,11 +112,17 @@ public:
     const std::string& driverInfo() const { return driverInfo_; }
     bool timestampsSupported() const { return timestampValidBits_ > 0 && properties_.limits.timestampComputeAndGraphics; }
     bool float64Supported() const { return float64_; }
+    // Why --precision fp64 is refused on this device although it has shader
+    // doubles (a driver it was measured to render wrong on); empty: it is not.
+    std::string fp64Refusal() const { return fp64RefusalFor(driverId_); }
+    static std::string fp64RefusalFor(VkDriverId driver);
     // The device's ray traversal is enabled (ContextOptions::rayQueries); if
     // not, rayQueryAbsence() says why, for a message.
     bool rayQueriesEnabled() const { return rayQueries_; }
     const std::string& rayQueryAbsence() const { return rayQueryAbsence_; }
     bool isCpuDevice() const { return properties_.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU; }
+    // The size of the largest device-local memory heap.
+    VkDeviceSize deviceLocalBytes() const;
     // Mesa's llvmpipe (lavapipe): its shaders end all loops after 65535
     // iterations per SIMD row and dispatch, which the renderer works around.
     bool isLlvmpipe() const { return driverId_ == VK_DRIVER_ID_MESA_LLVMPIPE; }
@@ -123,10 +130,16 @@ public:
     std::uint32_t validationMessages() const { return validationMessages_; }
     const std::vector<DeviceReport>& deviceReports() const { return reports_; }
 
-    // Device-local when possible; host-visible (and mapped) when asked. A
-    // usage with VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT gets memory that
-    // has one (deviceAddress).
-    Buffer createBuffer(VkDeviceSize size, VkBufferUsageFlags usage, bool hostVisible);
+    // Where a buffer lives. A usage with VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT
+    // gets memory that has one (deviceAddress).
+    enum class Memory {
+        Device,       // device-local where possible; the host never maps it
+        HostCached,   // mapped, host-cached where possible: the host reads much of what the device wrote
+        DeviceMapped, // mapped, device-local where possible: the device works on it (atomics, frequent
+                      // writes) while the host peeks at a few words; on a discrete GPU host memory
+                      // would send every one of those over the bus
+    };
+    Buffer createBuffer(VkDeviceSize size, VkBufferUsageFlags usage, Memory memory);
     // A device-local buffer holding `bytes` (staged through a host buffer when
     // device-local memory is not host-visible).
     Buffer createBufferWithData(const void* bytes, VkDeviceSize size, VkBufferUsageFlags usage);
