@@ -49,7 +49,8 @@ void addDeviceOptions(CLI::App& command, DeviceOptions& o) {
     command.add_option("--gpu", o.gpu, "Vulkan device index (see 'snell devices'; default: $SNELL_GPU, else the best)")
         ->envname("SNELL_GPU")->check(CLI::NonNegativeNumber);
     command.add_option("--precision", o.precision,
-                       "GPU arithmetic for geometry: fp32 (default) or fp64 (needs shaderFloat64; slower; not on NVIDIA's driver)")
+                       "GPU arithmetic for geometry: fp32 (default) or fp64 (needs shaderFloat64; slower; "
+                       "not on NVIDIA's driver)")
         ->check(CLI::IsMember({"fp32", "fp64"}));
     command.add_option("--traversal", o.traversal,
                        "How BVH scenes are searched: bvh (snell's walk), ray-query (the device's ray traversal, "

@@ -532,7 +532,8 @@ ComputeRenderer::TilePlan ComputeRenderer::planTiles(const RenderRequest& reques
         rayEntries * ((wide ? 2 : 1) * sizeof(gpu::PendingRay) + values[SNELL_SPEC_MAX_MEDIA] * 4);
     const VkDeviceSize limit = context_.properties().limits.maxStorageBufferRange;
     const bool cpu = plansForCpu();
-    VkDeviceSize budget = cpu ? kStackBudget : std::clamp(context_.deviceLocalBytes() / 16, kStackBudget, kGpuStackBudget);
+    const VkDeviceSize budget =
+        cpu ? kStackBudget : std::clamp(context_.deviceLocalBytes() / 16, kStackBudget, kGpuStackBudget);
     VkDeviceSize slots = std::min(budget, limit) / bytesPerSlot;
     if (cpu)
         slots = std::min<VkDeviceSize>(slots, SNELL_WORKGROUP_SIZE * kCpuWorkgroupsPerCore *
