@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "render/RenderRequest.h"
 #include "scene/Scene.h"
 
 namespace snell {
@@ -19,19 +20,20 @@ struct SceneReport {
     std::string text(const Scene& scene) const;
 };
 
-// What a render of the scene will be: its image size and supersampling.
+// What a render of the scene will be: its image size, supersampling and trace settings.
 struct RenderShape {
     int size = 0;
     int supersample = 1;
     bool defaultTree = true;  // the default trace settings (no --depth, --min-weight, --tolerance)
+    TraceSettings trace = kDefaultSettings;
 };
 
 // What looks wrong in a scene, the same for `check` and `render` (one set of
 // warnings, one set of thresholds), each saying what to do: the parser's;
 // lights inside spheres; spheres behind the camera; a scene that can only
-// render the background or black; a render whose size makes it expensive,
-// or whose amplifying materials do at the defaults (measured on a few
-// pixels with the CPU reference). `path`: the scene's file, for the warnings' locations.
+// render the background or black; a render expected to trace many rays
+// (its size, or its amplifying materials at the defaults; rays counted on a
+// few pixels with the CPU reference). `path`: the scene's file, for the warnings' locations.
 std::vector<Diagnostic> sceneWarnings(const Scene& scene, const std::string& path, RenderShape shape);
 
 // The report of `snell check`: warnings at the scene's own size.

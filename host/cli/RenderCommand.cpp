@@ -281,7 +281,8 @@ int RenderCommand::run() {
     const double parseMs = msSince(parseStart);
     RenderRequest request = makeRequest(scene);
     if (!o_.quiet)
-        for (const Diagnostic& w : sceneWarnings(scene, sceneFile(o_.scene), {request.width, request.supersample, defaultTree()}))
+        for (const Diagnostic& w : sceneWarnings(scene, sceneFile(o_.scene),
+                                                  {request.width, request.supersample, defaultTree(), request.trace}))
             std::cerr << w.format("warning") << "\n";
 
     const std::string output = o_.output.empty() ? scene.name + ".png" : o_.output;
