@@ -113,6 +113,14 @@ using uint = std::uint32_t;
 // may have pixels left, and then a bit a word of those, set while the word is
 // not 0 (the host sets them all at the tile's first dispatch).
 #define SNELL_COUNTER_STRIDE 16
+// Where those bits lie, for a dispatch of `groups` workgroups (uint
+// arithmetic in GLSL, std::uint64_t in C++): the first counter of the
+// shares' bits, their count of words, the first counter of the words' bits
+// and the whole buffer's count of counters.
+#define SNELL_SHARE_BITS_AT(groups) (SNELL_COUNTER_COUNT + (groups) * SNELL_COUNTER_STRIDE)
+#define SNELL_SHARE_WORDS(groups) (((groups) + 31u) / 32u)
+#define SNELL_WORD_BITS_AT(groups) (SNELL_SHARE_BITS_AT(groups) + SNELL_SHARE_WORDS(groups))
+#define SNELL_COUNTERS_FOR(groups) (SNELL_WORD_BITS_AT(groups) + (SNELL_SHARE_WORDS(groups) + 31u) / 32u)
 
 // Mesa's llvmpipe before 24 (lavapipe in Debian 12's Mesa 22.3) ends every
 // loop of a shader once one SIMD row has run 65535 loop iterations in total in

@@ -820,10 +820,10 @@ uint takeFromHelpedShare() {
 // share, and above them a bit a word of those, set while the word is not 0.
 // They spare a helper an atomic on every share taken: on a GPU, thousands of
 // workgroups each walking thousands of shares cost more than the tile.
-uint shareWords() { return (gl_NumWorkGroups.x + 31u) / 32u; }
+uint shareWords() { return SNELL_SHARE_WORDS(gl_NumWorkGroups.x); }
 // The counter holding share s's bit, and that holding share word w's bit.
-uint shareBitsAt(uint s) { return SNELL_COUNTER_COUNT + gl_NumWorkGroups.x * SNELL_COUNTER_STRIDE + s / 32u; }
-uint wordBitsAt(uint w) { return SNELL_COUNTER_COUNT + gl_NumWorkGroups.x * SNELL_COUNTER_STRIDE + shareWords() + w / 32u; }
+uint shareBitsAt(uint s) { return SNELL_SHARE_BITS_AT(gl_NumWorkGroups.x) + s / 32u; }
+uint wordBitsAt(uint w) { return SNELL_WORD_BITS_AT(gl_NumWorkGroups.x) + w / 32u; }
 // Share s has no pixel left: its bit cleared, and its word's once that is 0
 // (the clear that empties a word is the one that sees it go).
 void shareTaken(uint s) {

@@ -540,8 +540,9 @@ TEST(GpuPlan, TracesTheImageOfLavapipesPlan) {
         if (context().isCpuDevice()) {
             EXPECT_LT(own.invocations, planned.invocations);
             // grid: more shares than 32 words of bits, so the words' bits span words too.
-            if (scene.spheres.size() > snell::gpu::kBvhThreshold)
+            if (scene.spheres.size() > snell::gpu::kBvhThreshold) {
                 EXPECT_GT(planned.invocations, 32 * 32 * SNELL_WORKGROUP_SIZE);
+            }
         }
         ASSERT_EQ(planned.image.rgb.size(), own.image.rgb.size());
         std::size_t differ = 0;

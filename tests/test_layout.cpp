@@ -134,6 +134,18 @@ TEST(Layout, SlotStateAndPendingRay) {
     EXPECT_EQ(offsetof(gpu::PendingRay, resumeShading), 60u);
 }
 
+// The counters buffer: the shares' bits after every workgroup's counters, one
+// bit a workgroup; the words' bits after them, one a word; nothing overlaps.
+TEST(Layout, ShareBitsFollowTheWorkgroupsCounters) {
+    for (std::uint64_t groups : {1u, 31u, 32u, 33u, 1024u, 1025u, 4297u}) {
+        const std::uint64_t words = (groups + 31) / 32;
+        EXPECT_EQ(SNELL_SHARE_WORDS(groups), words) << groups;
+        EXPECT_EQ(SNELL_SHARE_BITS_AT(groups), SNELL_COUNTER_COUNT + groups * SNELL_COUNTER_STRIDE) << groups;
+        EXPECT_EQ(SNELL_WORD_BITS_AT(groups), SNELL_SHARE_BITS_AT(groups) + words) << groups;
+        EXPECT_EQ(SNELL_COUNTERS_FOR(groups), SNELL_WORD_BITS_AT(groups) + (words + 31) / 32) << groups;
+    }
+}
+
 TEST(Layout, ArrayStridesAreVec4Multiples) {
     // std430 arrays of structs containing vec4 have a stride that is a multiple of 16.
     EXPECT_EQ(sizeof(gpu::Sphere) % 16, 0u);

@@ -381,11 +381,10 @@ void memoryBarrier(VkCommandBuffer cmd, VkAccessFlags srcAccess, VkAccessFlags d
 
 // The dispatch's counters, then each workgroup's, then the bits of the
 // shares with pixels left and those of their words (shared_layout.h).
-std::size_t shareBitsAt(std::uint64_t workgroups) { return SNELL_COUNTER_COUNT + workgroups * SNELL_COUNTER_STRIDE; }
-std::size_t shareWords(std::uint64_t workgroups) { return (workgroups + 31) / 32; }
-std::size_t counterCount(std::uint64_t workgroups) {
-    return shareBitsAt(workgroups) + shareWords(workgroups) + (shareWords(workgroups) + 31) / 32;
-}
+std::size_t shareBitsAt(std::uint64_t workgroups) { return SNELL_SHARE_BITS_AT(workgroups); }
+std::size_t shareWords(std::uint64_t workgroups) { return SNELL_SHARE_WORDS(workgroups); }
+std::size_t wordBitsAt(std::uint64_t workgroups) { return SNELL_WORD_BITS_AT(workgroups); }
+std::size_t counterCount(std::uint64_t workgroups) { return SNELL_COUNTERS_FOR(workgroups); }
 // Bits 0..n-1 set in words from counters[at] on.
 void setBits(std::uint32_t* counters, std::size_t at, std::uint64_t n) {
     for (std::uint64_t i = 0; i < n; i += 32) counters[at + i / 32] = n - i >= 32 ? ~0u : (1u << (n - i)) - 1u;
@@ -821,7 +820,7 @@ void ComputeRenderer::dispatchTile(Pipeline& p, const RenderRequest& request, co
         std::memset(counters, 0, (pass > 0 ? SNELL_COUNTER_COUNT : counterCount(groups)) * sizeof(std::uint32_t));
         if (pass == 0) {
             setBits(counters, shareBitsAt(groups), groups);
-            setBits(counters, shareBitsAt(groups) + shareWords(groups), shareWords(groups));
+            setBits(counters, wordBitsAt(groups), shareWords(groups));
         }
         tile.resume = pass > 0 ? 1u : 0u;
         if (pass == 0) std::memset(p.slotStates.mapped, 0, plan.invocations * sizeof(gpu::SlotState));
