@@ -13,12 +13,16 @@ layout(constant_id = SNELL_SPEC_LOOP_BUDGET) const uint LOOP_BUDGET = 0u;
 
 // Loop iterations this subgroup has run in this dispatch, as llvmpipe's loop
 // limiter counts them (at least): it counts every pass of a loop with some lane
-// active, and a loop that no lane enters still runs its body once (masked),
-// as old llvmpipe executes both sides of every branch. One lane of the active
-// ones counts each pass, so the subgroup's sum is the count; where a pass may
-// hold a loop that no lane enters, it counts that loop's one pass too. The
-// shader's only loops are the passes over rays, over lights, and of the BVH
-// walk or the sphere loop; the rest are unrolled.
+// active, and one more, masked, that ends it; and a loop that no lane enters
+// still runs that one pass, loops nested in it included, as old llvmpipe
+// executes both sides of every branch. One lane of the active ones counts
+// each pass, so the subgroup's sum is the count. The masked passes no lane
+// can count: code that every lane runs counts them ahead, for each loop (and
+// those nested in it) that the code after it may reach. The shader's loops
+// are the passes over rays, over lights, of the BVH walk or the sphere loop,
+// and of takePixel's search for a share with pixels left; the rest are
+// unrolled. Counting too few lets the driver end a loop early (a walk cut
+// short: a sphere missed); too many only suspends sooner.
 uint loopTicks = 0u;
 void tick(uint passes) {
     if (LOOP_BUDGET != 0u && subgroupElect()) loopTicks += passes;

@@ -835,6 +835,7 @@ uint nextWordLeft(uint w) {
     const uint count = (shareWords() + 31u) / 32u;
     uint k = w / 32u;
     uint bits = counters[wordBitsAt(w)] & ~((1u << (w % 32u)) - 1u);
+    tick(1u);  // the pass that ends the loop (loop_budget.glsl)
     for (uint n = 0u; n <= count; ++n) {
         tick(1u);
         if (bits != 0u) return k * 32u + uint(findLSB(bits));
@@ -849,6 +850,7 @@ uint nextShareLeft(uint s) {
     if (rest != 0u) return s / 32u * 32u + uint(findLSB(rest));
     const uint words = shareWords();
     uint w = s / 32u;
+    tick(2u);  // the pass that ends the loop, and nextWordLeft's in it
     for (uint n = 0u; n <= words; ++n) {
         tick(1u);
         w = nextWordLeft(w + 1u == words ? 0u : w + 1u);
@@ -864,6 +866,7 @@ uint takePixel() {
     if (!HELPS) return min(pixel, tilePixels);
     // Each failed take clears its share's bit, and bits are only cleared, so
     // this ends. These loops count towards the loop budget like the others.
+    tick(3u);  // the pass that ends the loop, and those of the two loops in it
     while (pixel >= tilePixels) {
         tick(1u);
         shareTaken(helpedShare);
@@ -1078,7 +1081,10 @@ void main() {
         } else if (done) {
             break;
         }
-        tick(2u);  // this pass, and the closest-hit loop should no lane enter it
+        // This pass, and ahead the pass that ends each loop the pass reaches
+        // (loop_budget.glsl): the closest-hit walk, the lights' loop and the
+        // occlusion walk in it, takePixel's three (endStep).
+        tick(2u + (HAS_LIGHTS ? 2u : 0u) + (HELPS ? 3u : 0u));
         // Asked to stop (Ctrl-C, SIGTERM) while the dispatch runs: this
         // invocation drops its work and the host discards the tile. Read every
         // 256 passes, so even a pixel whose tree never ends is left promptly.
