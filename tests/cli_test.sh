@@ -264,6 +264,13 @@ printf 'view 8192 1\nlight 1 1 1 0 0 5\nmove 0 0 -3\nsphere\n' >"$work/big.scn"
 "$SNELL" render "$work/big.scn" --supersample 3 --region 0 0 1 1 -o "$work/x.png" 2>"$work/err" &&
   grep -q "big.scn: warning: this render traces about [0-9.]*e+08 rays (8192x8192 pixels.*--size 341" "$work/err" &&
   ok || bad "no warning of an expensive render: $(cat "$work/err")"
+# Beyond some thousands of spheres the count would cost more than it saves:
+# the camera rays stand in, as a lower bound.
+awk 'BEGIN { print "view 16384 1"; print "light 1 1 1 0 5 5";
+  for (i = 0; i < 16400; i++) printf "group\nmove %d %d -20\nscale 0.1 0.1 0.1\nsphere\ngroupend\n", i % 128 - 64, int(i / 128) - 64 }' >"$work/many.scn"
+"$SNELL" render "$work/many.scn" --supersample 2 --region 0 0 1 1 -o "$work/x.png" 2>"$work/err" &&
+  grep -q "many.scn: warning: this render traces at least 1.1e+09 rays (16384x16384 pixels, 4 camera rays each)" "$work/err" &&
+  ok || bad "no lower bound for a scene of many spheres: $(cat "$work/err")"
 "$SNELL" render "$work/big.scn" --size 64 -o "$work/big.png" 2>"$work/err" && [ ! -s "$work/err" ] && ok || bad "warned at a small size: $(cat "$work/err")"
 "$SNELL" render "$SCENES/basic.scn" --size 24 -o "$work/x.png" 2>"$work/err" && [ ! -s "$work/err" ] && ok || bad "warnings on a plain scene: $(cat "$work/err")"
 # Amplifying materials at the defaults, on a large image: the cost and the
