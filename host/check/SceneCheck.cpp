@@ -135,9 +135,9 @@ constexpr int kCostSample = 8;  // 8 x 8 pixels spread over the image
 // that previews it cheaply. The rays are counted, not guessed from the
 // image's size: 8192² of one sphere is 8e7 rays and about a second on
 // 2-core lavapipe; SphereFlake4's own 10000² is 7e8 rays and minutes. The
-// count needs the reference's BVH, whose build costs more than the count
-// beyond some thousands of spheres (1.2 s of a 0.8 s `check` at 10^6): there
-// the camera rays alone, a lower bound, stand in for it.
+// count needs the reference's BVH, whose build outweighs the rest of
+// `check` beyond some thousands of spheres (at 10^6 it took `check` from
+// 0.8 to 2.2 s): there the camera rays alone, a lower bound, stand in.
 bool warnAboutCost(const Scene& scene, const RenderShape& shape, const std::string& path,
                    std::vector<Diagnostic>& out) {
     constexpr double kManyRays = 4e8;  // 6 s to 2.5 min at lavapipe's 1.3-33 Mrays/s a core, on 2 cores
