@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <optional>
 #include <sstream>
 
 #include "bvh/Bvh.h"
@@ -131,6 +132,21 @@ double raysPerPixel(const CpuRenderer& reference, const Scene& scene, const Rend
 
 constexpr int kCostSample = 8;  // 8 x 8 pixels spread over the image
 
+// The reference that counts the samples' rays, built (BVH and all) once for
+// both warnings that need it, and only where one does.
+class SampleReference {
+public:
+    explicit SampleReference(const Scene& scene) : scene_(scene) {}
+    const CpuRenderer& get() {
+        if (!reference_) reference_.emplace(scene_);
+        return *reference_;
+    }
+
+private:
+    const Scene& scene_;
+    std::optional<CpuRenderer> reference_;
+};
+
 // Many rays make a render expensive: say so before it starts, with the size
 // that previews it cheaply. The rays are counted, not guessed from the
 // image's size: 8192² of one sphere is 8e7 rays and about a second on
@@ -138,7 +154,7 @@ constexpr int kCostSample = 8;  // 8 x 8 pixels spread over the image
 // count needs the reference's BVH, whose build outweighs the rest of
 // `check` beyond some thousands of spheres (at 10^6 it took `check` from
 // 0.8 to 2.2 s): there the camera rays alone, a lower bound, stand in.
-bool warnAboutCost(const Scene& scene, const RenderShape& shape, const std::string& path,
+bool warnAboutCost(const Scene& scene, const RenderShape& shape, const std::string& path, SampleReference& reference,
                    std::vector<Diagnostic>& out) {
     constexpr double kManyRays = 4e8;  // 6 s to 2.5 min at lavapipe's 1.3-33 Mrays/s a core, on 2 cores
     constexpr double kPreviewCameraRays = 1 << 20;  // 1024 x 1024 at one sample
@@ -146,7 +162,7 @@ bool warnAboutCost(const Scene& scene, const RenderShape& shape, const std::stri
     const double cameraRays = double(shape.size) * shape.size * shape.supersample * shape.supersample;
     if (scene.spheres.empty() || cameraRays <= kPreviewCameraRays) return false;
     const bool counted = scene.spheres.size() <= kMaxCountedSpheres;
-    const double perPixel = counted ? raysPerPixel(CpuRenderer(scene), scene, shape, kCostSample, shape.trace)
+    const double perPixel = counted ? raysPerPixel(reference.get(), scene, shape, kCostSample, shape.trace)
                                     : double(shape.supersample) * shape.supersample;
     const double total = perPixel * double(shape.size) * shape.size;
     if (total <= kManyRays) return false;
@@ -172,19 +188,18 @@ bool warnAboutCost(const Scene& scene, const RenderShape& shape, const std::stri
 // saturates (SPEC §4): measure what that costs on a sparse sample of the
 // image, with the reference, against POV-Ray's fixed tree.
 bool warnAboutAmplifying(const Scene& scene, const RenderShape& shape, const std::string& path,
-                         std::vector<Diagnostic>& out) {
+                         SampleReference& reference, std::vector<Diagnostic>& out) {
     constexpr int kSample = kCostSample;
     constexpr double kManyRays = 1e8;       // seconds on a CPU Vulkan driver
     if (!shape.defaultTree || !scene.anyAmplifying() || scene.spheres.empty() || shape.size <= 0) return false;
-    const CpuRenderer reference(scene);
-    const double perPixel = raysPerPixel(reference, scene, shape, kSample, kDefaultSettings);
+    const double perPixel = raysPerPixel(reference.get(), scene, shape, kSample, kDefaultSettings);
     const double total = perPixel * double(shape.size) * shape.size;
     if (total <= kManyRays) return false;
     TraceSettings fixed = kDefaultSettings;
     fixed.maxDepth = 5;
     fixed.minWeight = 0.0;
     fixed.tolerance = 0.0;
-    const double fixedPerPixel = raysPerPixel(reference, scene, shape, kSample, fixed);
+    const double fixedPerPixel = raysPerPixel(reference.get(), scene, shape, kSample, fixed);
     char text[400];
     std::snprintf(text, sizeof text,
                   "at the defaults this render may trace up to %.2g rays (%.0f a pixel on %dx%d of them, traced "
@@ -205,7 +220,8 @@ std::vector<Diagnostic> sceneWarnings(const Scene& scene, const std::string& pat
     warnAboutDarkness(scene, path, out);
     // The amplifying warning names the cheaper tree; the size's, a cheaper
     // preview. Where both apply, the tree is the cause.
-    if (!warnAboutAmplifying(scene, shape, path, out)) warnAboutCost(scene, shape, path, out);
+    SampleReference reference(scene);
+    if (!warnAboutAmplifying(scene, shape, path, reference, out)) warnAboutCost(scene, shape, path, reference, out);
     return out;
 }
 
