@@ -261,25 +261,35 @@ grep -q "dark.scn:3:1: warning: this sphere is behind the camera" "$work/check-w
 # warning from check or render), 9 samples a pixel of it are not.
 printf 'view 8192 1\nlight 1 1 1 0 0 5\nmove 0 0 -3\nsphere\n' >"$work/big.scn"
 "$SNELL" check "$work/big.scn" >/dev/null 2>"$work/err" && [ ! -s "$work/err" ] && ok || bad "warned of a cheap render: $(cat "$work/err")"
-"$SNELL" render "$work/big.scn" --supersample 3 --region 0 0 1 1 -o "$work/x.png" 2>"$work/err" &&
-  grep -q "big.scn: warning: this render traces about [0-9.]*e+08 rays (8192x8192 pixels.*--size 341" "$work/err" &&
+printf 'supersample 3\n' | cat "$work/big.scn" - >"$work/big3.scn"
+"$SNELL" check "$work/big3.scn" >/dev/null 2>"$work/err" &&
+  grep -q "big3.scn: warning: this render traces about [0-9.]*e+08 rays (8192x8192 pixels.*--size 341 previews" "$work/err" &&
   ok || bad "no warning of an expensive render: $(cat "$work/err")"
+# A render's cost is that of the pixels it renders: --region counts. The
+# warnings come before the render starts; the interrupt ends a render that
+# the warning rightly calls expensive.
+"$SNELL" render "$work/big3.scn" --region 0 0 1 1 -o "$work/x.png" 2>"$work/err" && [ ! -s "$work/err" ] && ok ||
+  bad "warned of a one-pixel region: $(cat "$work/err")"
+timeout -s INT 20 "$SNELL" render "$work/big.scn" --supersample 4 --region 0 0 8192 4096 -o "$work/x.png" 2>"$work/err"
+grep -q "big.scn: warning: this render traces about [0-9.]*e+08 rays (8192x4096 pixels of the region.*--size 256 without --region" "$work/err" &&
+  ok || bad "no warning of an expensive region: $(cat "$work/err")"
 # Beyond some thousands of spheres the count would cost more than it saves:
 # the camera rays stand in, as a lower bound.
-awk 'BEGIN { print "view 16384 1"; print "light 1 1 1 0 5 5";
+awk 'BEGIN { print "view 16384 1"; print "supersample 2"; print "light 1 1 1 0 5 5";
   for (i = 0; i < 16400; i++) printf "group\nmove %d %d -20\nscale 0.1 0.1 0.1\nsphere\ngroupend\n", i % 128 - 64, int(i / 128) - 64 }' >"$work/many.scn"
-"$SNELL" render "$work/many.scn" --supersample 2 --region 0 0 1 1 -o "$work/x.png" 2>"$work/err" &&
+"$SNELL" check "$work/many.scn" >/dev/null 2>"$work/err" &&
   grep -q "many.scn: warning: this render traces at least 1.1e+09 rays (16384x16384 pixels, 4 camera rays each)" "$work/err" &&
   ok || bad "no lower bound for a scene of many spheres: $(cat "$work/err")"
 "$SNELL" render "$work/big.scn" --size 64 -o "$work/big.png" 2>"$work/err" && [ ! -s "$work/err" ] && ok || bad "warned at a small size: $(cat "$work/err")"
 "$SNELL" render "$SCENES/basic.scn" --size 24 -o "$work/x.png" 2>"$work/err" && [ ! -s "$work/err" ] && ok || bad "warnings on a plain scene: $(cat "$work/err")"
 # Amplifying materials at the defaults, on a large image: the cost and the
 # cheaper fixed tree are named; asking for a tree silences it.
-"$SNELL" render "$SCENES/glass.scn" --size 4096 --region 0 0 1 1 -o "$work/x.png" 2>"$work/err" &&
-  grep -q "glass.scn: warning: at the defaults this render may trace up to .* --depth 5 --min-weight 0" "$work/err" && ok ||
+sed 's/^view 256 /view 4096 /' "$SCENES/glass.scn" >"$work/glass4k.scn"
+"$SNELL" check "$work/glass4k.scn" >/dev/null 2>"$work/err" &&
+  grep -q "glass4k.scn: warning: at the defaults this render may trace up to .* --depth 5 --min-weight 0" "$work/err" && ok ||
   bad "no warning of an expensive amplifying render: $(cat "$work/err")"
-"$SNELL" render "$SCENES/glass.scn" --size 4096 --depth 5 --region 0 0 1 1 -o "$work/x.png" 2>"$work/err" &&
-  ! grep -q "at the defaults" "$work/err" && ok || bad "the defaults' warning with a fixed tree: $(cat "$work/err")"
+timeout -s INT 20 "$SNELL" render "$work/glass4k.scn" --depth 5 -o "$work/x.png" 2>"$work/err"
+! grep -q "at the defaults" "$work/err" && ok || bad "the defaults' warning with a fixed tree: $(cat "$work/err")"
 
 # --count-lanes measures the kernel without changing the image: shares of busy
 # lanes in [0, 1], a BVH walk counted only where there is a BVH.

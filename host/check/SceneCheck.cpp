@@ -115,12 +115,20 @@ void warnAboutDarkness(const Scene& scene, const std::string& path, std::vector<
 }
 
 // Rays a pixel's tree traces at `trace`, counted by the CPU reference on
-// `sample` x `sample` pixels spread over the image (their centres).
+// `sample` x `sample` pixels spread over the pixels the render traces (their
+// centres): the camera of the whole image, its pixels stretched to cover
+// the shape's area in `sample` steps each way.
 double raysPerPixel(const CpuRenderer& reference, const Scene& scene, const RenderShape& shape, int sample,
                     TraceSettings trace) {
+    const PixelWindow area = shape.area();
     RenderRequest r;
-    r.width = r.height = std::min(sample, shape.size);
-    r.camera = Camera::fromSpec(r.width, scene.halfWidth);
+    r.width = std::min(sample, area.width());
+    r.height = std::min(sample, area.height());
+    const Camera whole = Camera::fromSpec(shape.size, scene.halfWidth);
+    r.camera = whole;
+    r.camera.cornerDir = whole.cornerDir + double(area.x0) * whole.pixelRight + double(area.y0) * whole.pixelDown;
+    r.camera.pixelRight = whole.pixelRight * (double(area.width()) / r.width);
+    r.camera.pixelDown = whole.pixelDown * (double(area.height()) / r.height);
     r.supersample = shape.supersample;
     // A runaway tree (no budget) would never end the count: count a budget's worth.
     if (trace.treeBudget == 0) trace.treeBudget = kDefaultSettings.treeBudget;
@@ -156,30 +164,37 @@ private:
 // 0.8 to 2.2 s): there the camera rays alone, a lower bound, stand in.
 bool warnAboutCost(const Scene& scene, const RenderShape& shape, const std::string& path, SampleReference& reference,
                    std::vector<Diagnostic>& out) {
-    constexpr double kManyRays = 4e8;  // 6 s to 2.5 min at lavapipe's 1.3-33 Mrays/s a core, on 2 cores
+    constexpr double kManyRays = 4e8;  // 3 s to 2.5 min at lavapipe's 1.3-70 Mrays/s a core, on 2 cores
     constexpr double kPreviewCameraRays = 1 << 20;  // 1024 x 1024 at one sample
     constexpr std::size_t kMaxCountedSpheres = 16384;  // a BVH build of some 20 ms
-    const double cameraRays = double(shape.size) * shape.size * shape.supersample * shape.supersample;
+    const PixelWindow area = shape.area();
+    const double pixels = double(area.width()) * area.height();
+    const double cameraRays = pixels * shape.supersample * shape.supersample;
     if (scene.spheres.empty() || cameraRays <= kPreviewCameraRays) return false;
     const bool counted = scene.spheres.size() <= kMaxCountedSpheres;
     const double perPixel = counted ? raysPerPixel(reference.get(), scene, shape, kCostSample, shape.trace)
                                     : double(shape.supersample) * shape.supersample;
-    const double total = perPixel * double(shape.size) * shape.size;
+    const double total = perPixel * pixels;
     if (total <= kManyRays) return false;
     const int previewSize = std::max(1, int(std::sqrt(kPreviewCameraRays) / shape.supersample));
-    const int sample = std::min(kCostSample, shape.size);
-    char how[200];
+    const double previewPixels = double(previewSize) * previewSize;
+    const bool whole = area == PixelWindow{0, 0, shape.size, shape.size};
+    char pixelsText[100];
+    std::snprintf(pixelsText, sizeof pixelsText, whole ? "%dx%d pixels" : "%dx%d pixels of the region",
+                  area.width(), area.height());
+    char how[250];
     if (counted)
-        std::snprintf(how, sizeof how, "about %.2g rays (%dx%d pixels, %.1f rays a pixel on %dx%d of them, counted "
-                      "with the CPU reference)", total, shape.size, shape.size, perPixel, sample, sample);
+        std::snprintf(how, sizeof how, "about %.2g rays (%s, %.1f rays a pixel on %dx%d of them, counted with the CPU "
+                      "reference)", total, pixelsText, perPixel, std::min(kCostSample, area.width()),
+                      std::min(kCostSample, area.height()));
     else
-        std::snprintf(how, sizeof how, "at least %.2g rays (%dx%d pixels, %d camera rays each)", total, shape.size,
-                      shape.size, shape.supersample * shape.supersample);
-    char text[500];
+        std::snprintf(how, sizeof how, "at least %.2g rays (%s, %d camera rays each)", total, pixelsText,
+                      shape.supersample * shape.supersample);
+    char text[600];
     std::snprintf(text, sizeof text,
-                  "this render traces %s; a CPU Vulkan driver traces 1 to 30 million rays a second a core, the "
-                  "fewer the more spheres a ray passes; --size %d previews it %.0fx faster",
-                  how, previewSize, double(shape.size) * shape.size / (double(previewSize) * previewSize));
+                  "this render traces %s; a CPU Vulkan driver traces 1 to 70 million rays a second a core, the "
+                  "fewer the more spheres a ray passes; --size %d%s previews it %.0fx faster",
+                  how, previewSize, whole ? "" : " without --region", pixels / previewPixels);
     out.push_back(aboutFile(path, text));
     return true;
 }
@@ -192,8 +207,9 @@ bool warnAboutAmplifying(const Scene& scene, const RenderShape& shape, const std
     constexpr int kSample = kCostSample;
     constexpr double kManyRays = 1e8;       // seconds on a CPU Vulkan driver
     if (!shape.defaultTree || !scene.anyAmplifying() || scene.spheres.empty() || shape.size <= 0) return false;
+    const PixelWindow area = shape.area();
     const double perPixel = raysPerPixel(reference.get(), scene, shape, kSample, kDefaultSettings);
-    const double total = perPixel * double(shape.size) * shape.size;
+    const double total = perPixel * double(area.width()) * area.height();
     if (total <= kManyRays) return false;
     TraceSettings fixed = kDefaultSettings;
     fixed.maxDepth = 5;
@@ -206,7 +222,7 @@ bool warnAboutAmplifying(const Scene& scene, const RenderShape& shape, const std
                   "with the CPU reference, which goes deeper than the GPU): light in materials with ks + kt > 1 "
                   "is followed until it saturates. A fixed tree, --depth 5 --min-weight 0 (POV-Ray's settings), "
                   "traces about %.0fx fewer rays, if its error is acceptable",
-                  total, perPixel, std::min(kSample, shape.size), std::min(kSample, shape.size),
+                  total, perPixel, std::min(kSample, area.width()), std::min(kSample, area.height()),
                   perPixel / std::max(1.0, fixedPerPixel));
     out.push_back(aboutFile(path, text));
     return true;

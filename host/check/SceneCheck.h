@@ -20,12 +20,15 @@ struct SceneReport {
     std::string text(const Scene& scene) const;
 };
 
-// What a render of the scene will be: its image size, supersampling and trace settings.
+// What a render of the scene will be: its image size, the pixels it renders
+// of it (--region; empty: all of them), supersampling and trace settings.
 struct RenderShape {
     int size = 0;
     int supersample = 1;
     bool defaultTree = true;  // the default trace settings (no --depth, --min-weight, --tolerance)
     TraceSettings trace = kDefaultSettings;
+    PixelWindow window;
+    PixelWindow area() const { return window.empty() ? PixelWindow{0, 0, size, size} : window; }
 };
 
 // What looks wrong in a scene, the same for `check` and `render` (one set of

@@ -282,7 +282,7 @@ int RenderCommand::run() {
     RenderRequest request = makeRequest(scene);
     if (!o_.quiet)
         for (const Diagnostic& w : sceneWarnings(scene, sceneFile(o_.scene),
-                                                  {request.width, request.supersample, defaultTree(), request.trace}))
+                                                  {request.width, request.supersample, defaultTree(), request.trace, request.window}))
             std::cerr << w.format("warning") << "\n";
 
     const std::string output = o_.output.empty() ? scene.name + ".png" : o_.output;
