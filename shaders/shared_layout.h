@@ -233,7 +233,7 @@ struct SlotState {
     float lastMove;      // how far the last step moved the colour (ErrorEstimate)
     float moveBefore;    // and the step before it
     float settledWeight; // the weight the pixel had not traced after the last step, in channels under 1, per sample
-    uint pad0;
+    uint droppedGrowing; // 1: light that may grow was dropped for want of room (a full frontier or ray stack)
     uint pad1;
     uint pad2;
 };
@@ -242,7 +242,8 @@ struct SlotState {
 struct OutputPixel {
     vec4 colour;      // rgb: the colour (unclamped); a: its truncation bound, negative where not finite
     vec4 truncation;  // x: the estimated error where it stopped on one (render/Truncation.h), else −1;
-                      // y: 1 where the tree budget stopped it; z: 1 where it ended over the tolerance;
+                      // y: 1 where the tree budget stopped it; z: 1 where it ended over the tolerance,
+                      // 2 where that is because light that may grow was dropped (SlotState::droppedGrowing);
                       // w: the rays (closest-hit queries) its trees traced, its cost (RenderRequest::rayImage)
 };
 

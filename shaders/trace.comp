@@ -473,6 +473,9 @@ void deferRay(uint slot, inout SlotState state, Ray r) {
         state.deferred.rgb += r.weight;
         state.heaviestLeft = max(state.heaviestLeft, m);
     } else {
+        // Light that may grow, lost for want of room (the CPU reference keeps
+        // it): no estimate of the pixel's error holds.
+        if (mayGoBelowFloor && FRONTIER > 0u) state.droppedGrowing = 1u;
         state.lost.rgb += r.weight;
     }
 }
@@ -696,7 +699,10 @@ bool spawnChildren(uint slot, inout SlotState state, inout Ray r, vec3 weight, H
     // Full (only an amplifying tree can fill it): the child that would wait is
     // lost, its weight counted in the bound, and the host says so.
     bool stackFull = state.pending + 1u >= RAY_STACK;
-    if (both && stackFull) atomicAdd(counters[SNELL_COUNTER_OVERFLOW], 1u);
+    if (both && stackFull) {
+        atomicAdd(counters[SNELL_COUNTER_OVERFLOW], 1u);
+        if (TRAPS) state.droppedGrowing = 1u;  // as on a full frontier (deferRay)
+    }
     if (both && !refractedWaits) {
         if (stackFull) state.lost.rgb += reflectedWeight;
         else pushRay(slot, state.pending, reflectedRay);  // with the parent's media, still current
@@ -881,10 +887,14 @@ uint takePixel() {
 // The finished pixel written out (render/Truncation.h: its colour, bound and
 // how it stopped), and the invocation moved on to its next pixel.
 void finishPixel(uint slot, inout SlotState state, StepOutcome o, uint shadowRays) {
-    bool overTolerance = tolerance > 0.0 && !o.certified && !o.settled;
+    // A pixel that dropped light that may grow, and has not saturated, has
+    // neither a bound nor an estimate: it is over the tolerance, and says why.
+    bool dropped = state.droppedGrowing != 0u && o.unbounded;
+    bool overTolerance = tolerance > 0.0 && !o.certified && (!o.settled || dropped);
     outputPixels[state.pixel] = OutputPixel(
         vec4(state.lower.rgb, o.unbounded ? -o.bound : o.bound),
-        vec4(o.settled ? o.estimate : -1.0, float(state.overBudget), overTolerance ? 1.0 : 0.0, float(state.treeRays)));
+        vec4(o.settled && !dropped ? o.estimate : -1.0, float(state.overBudget),
+             dropped ? 2.0 : overTolerance ? 1.0 : 0.0, float(state.treeRays)));
     uint finished = state.finished + 1u;
     uint rays = state.rays;
     state = freshPixel(takePixel());

@@ -291,6 +291,20 @@ sed 's/^view 256 /view 4096 /' "$SCENES/glass.scn" >"$work/glass4k.scn"
 timeout -s INT 20 "$SNELL" render "$work/glass4k.scn" --depth 5 -o "$work/x.png" 2>"$work/err"
 ! grep -q "at the defaults" "$work/err" && ok || bad "the defaults' warning with a fixed tree: $(cat "$work/err")"
 
+# Light that may grow (a trap) dropped for want of frontier room: the GPU says
+# which pixels, and claims no estimate for them; the reference keeps it all.
+"$SNELL" render "$SCENES/hard/glass-in-water-gap-0.scn" --size 48 --stats -o "$work/x.png" >"$work/stats" 2>"$work/err"
+grep -q "warning: [0-9]* pixel(s) dropped light trapped in a material with ks + kt > 1.*e.g. ([0-9]*, [0-9]*)" "$work/err" &&
+  python3 -c '
+import json, sys
+t = json.load(open(sys.argv[1]))["truncation"]
+assert t["dropped_growing_pixels"] > 0 and t["over_tolerance_pixels"] >= t["dropped_growing_pixels"], t
+assert t["estimated_pixels"] + t["dropped_growing_pixels"] <= t["unbounded_pixels"], t' "$work/stats" && ok ||
+  bad "no report of dropped light that may grow: $(cat "$work/err" "$work/stats")"
+"$SNELL" render "$SCENES/hard/glass-in-water-gap-0.scn" --size 48 --cpu --stats -o "$work/x.png" >"$work/stats" 2>"$work/err"
+! grep -q "dropped light trapped" "$work/err" && grep -q '"dropped_growing_pixels": 0' "$work/stats" && ok ||
+  bad "the reference reported dropped light: $(cat "$work/err")"
+
 # --count-lanes measures the kernel without changing the image: shares of busy
 # lanes in [0, 1], a BVH walk counted only where there is a BVH.
 "$SNELL" render "$SCENES/grid.scn" --size 32 -q -o "$work/lanes.png" --count-lanes --stats >"$work/stats" &&

@@ -65,12 +65,18 @@ void printTruncationWarnings(const TruncationReport& t, const TraceSettings& set
         if (count > pixels.size()) s += ", ...";
         return ", e.g. " + s;
     };
-    if (t.unbounded > t.estimated)
-        std::cerr << "snell: warning: " << t.unbounded - t.estimated
+    if (t.unbounded > t.estimated + t.droppedGrowing)
+        std::cerr << "snell: warning: " << t.unbounded - t.estimated - t.droppedGrowing
                   << " pixel(s) dropped light of a material with ks + kt >= 1, which need not decay, and their "
                   << "colour had not settled at the floor cut-off " << settings.minWeight
                   << ": the image is not certified there (--bound-image shows where); a lower --min-weight "
                   << "traces them further" << examples(t.unboundedExamples, t.unbounded) << "\n";
+    if (t.droppedGrowing > 0)
+        std::cerr << "snell: warning: " << t.droppedGrowing << " pixel(s) dropped light trapped in a material "
+                  << "with ks + kt > 1, which may grow, for want of room to keep it for their next step: their "
+                  << "error is not estimated and the image is not certified there (--bound-image shows where); "
+                  << "the CPU reference (--cpu) keeps all of it" << examples(t.droppedGrowingExamples, t.droppedGrowing)
+                  << "\n";
     if (t.overBudget > 0)
         std::cerr << "snell: warning: " << t.overBudget << " pixel(s) reached the tree budget of "
                   << settings.treeBudget << " rays a sample and were stopped (their bound says by how much they "
@@ -87,6 +93,7 @@ std::string truncationJson(const TruncationReport& t) {
     j << "{\"max_bound\": " << t.maxBound << ", \"mean_bound\": " << t.meanBound()
       << ", \"unbounded_pixels\": " << t.unbounded << ", \"over_budget_pixels\": " << t.overBudget
       << ", \"over_tolerance_pixels\": " << t.overTolerance << ", \"estimated_pixels\": " << t.estimated
+      << ", \"dropped_growing_pixels\": " << t.droppedGrowing
       << ", \"max_estimated_error\": " << t.maxEstimate << ", \"deepest_ray\": " << t.deepest << "}";
     return j.str();
 }

@@ -208,8 +208,14 @@ void TruncationReport::addEstimate(double error) {
     maxEstimate = std::max(maxEstimate, error);
 }
 
+void TruncationReport::addDroppedGrowing(int x, int y) {
+    ++droppedGrowing;
+    if (droppedGrowingExamples.size() < kExamples) droppedGrowingExamples.push_back({x, y});
+}
+
 void TruncationReport::merge(const TruncationReport& o) {
     estimated += o.estimated;
+    droppedGrowing += o.droppedGrowing;
     maxEstimate = std::max(maxEstimate, o.maxEstimate);
     maxBound = std::max(maxBound, o.maxBound);
     sumBound += o.sumBound;
@@ -222,6 +228,8 @@ void TruncationReport::merge(const TruncationReport& o) {
         if (unboundedExamples.size() < kExamples) unboundedExamples.push_back(e);
     for (const auto& e : o.overBudgetExamples)
         if (overBudgetExamples.size() < kExamples) overBudgetExamples.push_back(e);
+    for (const auto& e : o.droppedGrowingExamples)
+        if (droppedGrowingExamples.size() < kExamples) droppedGrowingExamples.push_back(e);
 }
 
 }  // namespace snell

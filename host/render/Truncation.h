@@ -127,15 +127,19 @@ struct TruncationReport {
     std::uint64_t overBudget = 0;    // pixels stopped by the tree budget, not finished
     std::uint64_t overTolerance = 0; // pixels still above the tolerance when the cut-off reached its floor
     std::uint64_t estimated = 0;     // unbounded pixels stopped by their estimated error (ErrorEstimate)
+    std::uint64_t droppedGrowing = 0; // unbounded pixels, over the tolerance and unestimated, that dropped
+                                      // light that may grow for want of room (the GPU's frontier or stack)
     double maxEstimate = 0.0;        // the largest estimated error of those
     int deepest = 0;                 // the deepest ray traced (generations below the primary ray)
     static constexpr std::size_t kExamples = 8;
     std::vector<std::array<int, 2>> unboundedExamples;   // the first few, (x, y)
     std::vector<std::array<int, 2>> overBudgetExamples;
+    std::vector<std::array<int, 2>> droppedGrowingExamples;
 
     double meanBound() const { return pixels ? sumBound / double(pixels) : 0.0; }
     void addPixel(int x, int y, double bound, bool isUnbounded, bool isOverBudget);
     void addEstimate(double error);  // the pixel just added was stopped by its estimated error
+    void addDroppedGrowing(int x, int y);
     void merge(const TruncationReport& other);
 };
 
