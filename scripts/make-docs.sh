@@ -136,7 +136,8 @@ run under the Khronos validation layer (VK_LAYER_KHRONOS_validation, which
 must be installed); a render fails on any message from it.
 .TP
 .B SNELL_CACHE_DIR
-The directory that keeps compiled pipelines between runs (see
+The directory that keeps compiled pipelines and specialised kernels
+between runs (see
 .BR FILES ).
 .TP
 .B XDG_CACHE_HOME
@@ -178,13 +179,17 @@ unset.
 .TP
 .I \%~/.cache/snell/pipelines.bin
 Compute pipelines compiled by the Vulkan driver, kept so that later runs
-start faster. With
+start faster; beside it,
+.IR modules/ ,
+the kernel of each scene structure with its specialisation constants
+folded in (the driver then compiles less: on lavapipe, 14\(en21 ms less a
+start; up to 256 are kept). With
 .B SNELL_CACHE_DIR
 or
 .B XDG_CACHE_HOME
-set, it lies in the directory they name instead (see
+set, they lie in the directory they name instead (see
 .BR ENVIRONMENT ).
-Removing it is harmless.
+Removing them is harmless.
 EOF
   echo ".TP"
   echo ".I \\%$scene_format"

@@ -17,7 +17,7 @@ apt_update() { [ -n "$apt_updated" ] || { $SUDO apt-get update -q; apt_updated=1
 
 packages=(cmake ninja-build g++ pkg-config
           libvulkan-dev mesa-vulkan-drivers vulkan-tools vulkan-validationlayers
-          glslang-tools libglm-dev libglfw3-dev libstb-dev libpng-dev libopenexr-dev libcli11-dev libgtest-dev
+          glslang-tools spirv-tools libglm-dev libglfw3-dev libstb-dev libpng-dev libopenexr-dev libcli11-dev libgtest-dev
           clang-14 libclang-rt-14-dev xvfb povray python3 python3-matplotlib)
 missing=()
 for p in "${packages[@]}"; do

@@ -5,6 +5,7 @@
 set -u
 : "${SNELL:?}" "${SCENES:?}"
 work=$(mktemp -d)
+export SNELL_CACHE_DIR="$work/cache"  # the test's own, not the user's
 trap 'rm -rf "$work"' EXIT
 pass=0 fail=0
 ok() { pass=$((pass + 1)); }
@@ -42,6 +43,18 @@ done
 [ $status -eq 2 ] && grep -q ".png, .ppm, .pfm or .exr" "$work/err" && ok || bad "unknown extension ($status)"
 "$SNELL" render "$SCENES/basic.scn" -o "$work/no/such/dir/x.png" 2>"$work/err"; status=$?
 [ $status -eq 1 ] && grep -q "does not exist" "$work/err" && ok || bad "missing output dir ($status)"
+
+# Where a cache directory is kept, the kernel's specialisation is folded in
+# before the driver sees it (kept there for the next run), with the same
+# image; without one, the driver specialises it.
+"$SNELL" render "$SCENES/glass.scn" --size 24 -q -o "$work/folded.pfm" --stats 2>/dev/null | tail -n 1 >"$work/stats"
+grep -q '"kernel": "folded"' "$work/stats" && ls "$SNELL_CACHE_DIR"/modules/*.spv >/dev/null 2>&1 && ok ||
+  bad "no folded kernel with a cache: $(cat "$work/stats")"
+MESA_SHADER_CACHE_DIR="${MESA_SHADER_CACHE_DIR:-$HOME/.cache/mesa_shader_cache}" SNELL_CACHE_DIR= XDG_CACHE_HOME= HOME= \
+  "$SNELL" render "$SCENES/glass.scn" --size 24 -q -o "$work/driver.pfm" --stats 2>/dev/null |
+  tail -n 1 >"$work/stats"
+grep -q '"kernel": "driver"' "$work/stats" && cmp -s "$work/driver.pfm" "$work/folded.pfm" && ok ||
+  bad "without a cache: $(cat "$work/stats")"
 
 # No Vulkan driver at all: status 1, a message naming the package, no file.
 VK_ICD_FILENAMES=/nonexistent/icd.json "$SNELL" render "$SCENES/basic.scn" -o "$work/nodev.png" 2>"$work/err"; status=$?

@@ -366,6 +366,24 @@ TEST(GpuInspection, SwitchesAndProgressiveSamplesMatchReference) {
 
 namespace {
 
+// A render of the whole image at `size`, at the defaults.
+snell::RenderRequest wholeImage(const snell::Scene& scene, int size) {
+    snell::RenderRequest request;
+    request.width = request.height = size;
+    request.supersample = scene.supersample;
+    request.camera = snell::Camera::fromSpec(size, scene.halfWidth);
+    request.trace = snell::kDefaultSettings;
+    return request;
+}
+
+// Pixels not the same bit for bit.
+std::size_t pixelsThatDiffer(const snell::Image& a, const snell::Image& b) {
+    std::size_t differ = 0;
+    for (std::size_t i = 0; i + 2 < a.rgb.size(); i += 3)
+        differ += !std::equal(&a.rgb[i], &a.rgb[i] + 3, &b.rgb[i]);
+    return differ;
+}
+
 // The invocations' suspend-and-resume path (taken where the driver limits
 // loops: old llvmpipe) gives the very image of one uninterrupted dispatch,
 // however often it suspends: mid-tree with nested media (glass), deep
@@ -377,11 +395,7 @@ TEST(GpuResume, SuspendingNeverChangesTheImage) {
                              SNELL_SOURCE_DIR "/scenes/showcase.scn"}) {
         SCOPED_TRACE(file);
         const snell::Scene scene = snell::parseSceneFile(file);
-        snell::RenderRequest request;
-        request.width = request.height = 40;
-        request.supersample = scene.supersample;
-        request.camera = snell::Camera::fromSpec(40, scene.halfWidth);
-        request.trace = snell::kDefaultSettings;
+        const snell::RenderRequest request = wholeImage(scene, 40);
         snell::ComputeRenderer gpu(context(), scene, request.camera);
         const snell::GpuRenderResult whole = gpu.render(request, false);
         gpu.forceLoopBudget(48);
@@ -523,14 +537,39 @@ TEST(GpuTiles, InterleavedTilesGiveTheImageOfBlocks) {
 // driver that limits loops (Mesa 22.3) this also checks the loop budget's
 // count of the share search's loops: counted too few, the driver cut a BVH
 // walk short and 3 pixels of grid came out as background.
+// The kernel with its specialisation folded in before the driver sees it
+// (vulkan/SpecialisedModule.h) traces the image the driver's own
+// specialisation traces, bit for bit: scenes of each kind of kernel (one
+// sphere; refraction and amplifying glass; a BVH; traps; a BVH of amplifying
+// glass), at the defaults.
+TEST(GpuSpecialisation, FoldedKernelTracesTheSameImage) {
+    ASSERT_FALSE(context().cacheDirectory().empty());
+    const fs::path modules = fs::path(context().cacheDirectory()) / "modules";
+    for (const char* file : {SNELL_SOURCE_DIR "/scenes/basic.scn", SNELL_SOURCE_DIR "/scenes/glass.scn",
+                             SNELL_SOURCE_DIR "/scenes/grid.scn", SNELL_SOURCE_DIR "/scenes/hard/glass-in-water-gap-0.scn",
+                             SNELL_SHARED_DIR "/course-scenes/becker-SphereFlake2.scn"}) {
+        SCOPED_TRACE(file);
+        const snell::Scene scene = snell::parseSceneFile(file);
+        const snell::RenderRequest request = wholeImage(scene, 96);
+        snell::ComputeRenderer driverSpecialised(context(), scene, request.camera);
+        driverSpecialised.foldSpecialisation(false);
+        const snell::GpuRenderResult own = driverSpecialised.render(request, false);
+        snell::ComputeRenderer folded(context(), scene, request.camera);
+        const snell::GpuRenderResult image = folded.render(request, false);
+        EXPECT_FALSE(driverSpecialised.kernelFolded());
+        EXPECT_TRUE(folded.kernelFolded());
+        EXPECT_FALSE(fs::is_empty(modules)) << "no folded module kept";
+        ASSERT_EQ(image.image.rgb.size(), own.image.rgb.size());
+        EXPECT_EQ(pixelsThatDiffer(own.image, image.image), 0u)
+            << "pixels that differ between the driver's specialisation and the folded one";
+    }
+}
+
 TEST(GpuPlan, TracesTheImageOfLavapipesPlan) {
     for (const char* file : {SNELL_SOURCE_DIR "/scenes/grid.scn", SNELL_SOURCE_DIR "/scenes/glass.scn"}) {
         SCOPED_TRACE(file);
         const snell::Scene scene = snell::parseSceneFile(file);
-        snell::RenderRequest request;
-        request.width = request.height = 512;
-        request.camera = snell::Camera::fromSpec(512, scene.halfWidth);
-        request.trace = snell::kDefaultSettings;
+        snell::RenderRequest request = wholeImage(scene, 512);
         request.trace.tolerance = 0.0;
         snell::ComputeRenderer gpu(context(), scene, request.camera);
         const snell::GpuRenderResult own = gpu.render(request, false);
@@ -544,9 +583,6 @@ TEST(GpuPlan, TracesTheImageOfLavapipesPlan) {
             }
         }
         ASSERT_EQ(planned.image.rgb.size(), own.image.rgb.size());
-        std::size_t differ = 0;
-        for (std::size_t i = 0; i < own.image.rgb.size(); i += 3)
-            differ += !std::equal(&own.image.rgb[i], &own.image.rgb[i] + 3, &planned.image.rgb[i]);
-        EXPECT_EQ(differ, 0u) << "pixels that differ between the plans";
+        EXPECT_EQ(pixelsThatDiffer(own.image, planned.image), 0u) << "pixels that differ between the plans";
     }
 }

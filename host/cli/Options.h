@@ -63,7 +63,8 @@ inline std::string sceneFile(const std::string& argument) { return argument == "
 // Help text of a scene argument.
 inline constexpr const char* kSceneHelp = "Scene file; - reads it from standard input";
 
-// Compiled pipelines persist here between runs: $SNELL_CACHE_DIR, else
+// Compiled pipelines persist here between runs, and beside them the kernels
+// with their specialisation folded in (vulkan/SpecialisedModule.h): $SNELL_CACHE_DIR, else
 // $XDG_CACHE_HOME/snell, else ~/.cache/snell; empty (no cache) if none is set.
 std::string pipelineCachePath();
 

@@ -105,6 +105,7 @@ struct RenderOutcome {
     RayCounts rays;
     std::string device;
     std::string traversal = "reference";  // ComputeRenderer::traversal() on the GPU
+    std::string kernel = "reference";     // on the GPU: "folded" (its specialisation folded in) or "driver"
     std::string timing = "host";  // how renderMs was measured
     double uploadMs = 0, pipelineMs = 0, renderMs = 0, readbackMs = 0;
     double estimateMs = 0;  // the progress bar's sparse render (estimateCost)
@@ -451,6 +452,7 @@ RenderOutcome RenderCommand::renderOnGpu(const Scene& scene, RenderRequest& requ
         request.expectedCost = nullptr;  // expectedCost ends here
         r.device = context.deviceName();
         r.traversal = renderer.traversal();
+        r.kernel = renderer.kernelFolded() ? "folded" : "driver";
         r.uploadMs = renderer.uploadMs();
         r.rays = g.rays;
         r.renderMs = g.renderMs;
@@ -494,6 +496,7 @@ std::string RenderCommand::statsJson(const Scene& scene, const RenderRequest& re
       << ", \"backend\": \"" << (o_.cpu ? "cpu" : "gpu") << "\", \"device\": " << jsonString(r.device)
       << ", \"precision\": \"" << (o_.cpu ? "fp64-reference" : o_.device.precision) << "\""
       << ", \"traversal\": \"" << r.traversal << "\""
+      << ", \"kernel\": \"" << r.kernel << "\""
       << ", \"width\": " << request.width << ", \"height\": " << request.height
       << ", \"supersample\": " << request.supersample << ", \"max_depth\": " << request.trace.maxDepth
       << ", \"min_weight\": " << request.trace.minWeight << ", \"spheres\": " << scene.spheres.size()

@@ -12,6 +12,7 @@
 #include "common/Clock.h"
 #include "gpu/DriverProbe.h"
 #include "render/WorkgroupSchedule.h"
+#include "vulkan/SpecialisedModule.h"
 #include "trace_comp_spv.h"       // generated at build time from shaders/trace.comp
 #include "trace_fp64_comp_spv.h"  // the same, compiled with SNELL_FP64
 #include "trace_ray_query_comp_spv.h"  // the same, compiled with SNELL_RAY_QUERY
@@ -62,6 +63,7 @@ struct ComputeRenderer::Pipeline {
     vk::Buffer frameLow, rayStackLow;  // fp64 only
     std::uint32_t rayEntries = 1;     // the RAY_STACK and FRONTIER specialisations: an invocation's entries
     std::uint32_t maxMedia = 1;       // the MAX_MEDIA specialisation
+    bool folded = false;              // the module has the specialisation folded in (vulkan/SpecialisedModule.h)
     std::vector<std::uint32_t> bindings;  // the shader's, in order
     // What it was built for: kept between renders and reused while these match.
     Specialisation values{};
@@ -266,7 +268,7 @@ void ComputeRenderer::createComputePipeline(Pipeline& p) {
     pipelineInfo.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
     pipelineInfo.stage.module = p.module;
     pipelineInfo.stage.pName = "main";
-    pipelineInfo.stage.pSpecializationInfo = &spec;
+    pipelineInfo.stage.pSpecializationInfo = p.folded ? nullptr : &spec;
     pipelineInfo.layout = p.layout;
     check(vkCreateComputePipelines(context_.device(), context_.pipelineCache(), 1, &pipelineInfo, nullptr,
                                    &p.pipeline),
@@ -301,11 +303,18 @@ void ComputeRenderer::createPipeline(const Specialisation& values, Pipeline& p) 
     layoutInfo.pPushConstantRanges = &push;
     check(vkCreatePipelineLayout(device, &layoutInfo, nullptr, &p.layout), "vkCreatePipelineLayout");
 
+    using Words = std::span<const std::uint32_t>;
+    const Words compiled = wide           ? Words(snell_trace_fp64_comp_spv)
+                           : sphereBoxes_ ? Words(snell_trace_ray_query_comp_spv)
+                                          : Words(snell_trace_comp_spv);
+    const std::vector<std::uint32_t> folded =
+        foldSpecialisation_ ? vk::specialisedModule(compiled, values, context_.cacheDirectory())
+                            : std::vector<std::uint32_t>();
+    p.folded = !folded.empty();
+    const Words code = p.folded ? Words(folded) : compiled;
     VkShaderModuleCreateInfo moduleInfo{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
-    moduleInfo.codeSize = wide ? sizeof(snell_trace_fp64_comp_spv)
-                          : sphereBoxes_ ? sizeof(snell_trace_ray_query_comp_spv)
-                                         : sizeof(snell_trace_comp_spv);
-    moduleInfo.pCode = wide ? snell_trace_fp64_comp_spv : sphereBoxes_ ? snell_trace_ray_query_comp_spv : snell_trace_comp_spv;
+    moduleInfo.codeSize = code.size_bytes();
+    moduleInfo.pCode = code.data();
     check(vkCreateShaderModule(device, &moduleInfo, nullptr, &p.module), "vkCreateShaderModule");
 
     p.rayEntries = values[SNELL_SPEC_RAY_STACK] + values[SNELL_SPEC_FRONTIER];
@@ -552,6 +561,8 @@ ComputeRenderer::TilePlan ComputeRenderer::planTiles(const RenderRequest& reques
     plan.helps = values[SNELL_SPEC_HELPS] != 0;
     return plan;
 }
+
+bool ComputeRenderer::kernelFolded() const { return cached_ && cached_->folded; }
 
 ComputeRenderer::Pipeline& ComputeRenderer::ensurePipeline(const Specialisation& values, bool& created) {
     // The pipeline of the last render serves again when the specialisation

@@ -92,6 +92,11 @@ public:
     // image must not change; under a tolerance the shorter frontiers may
     // trace some rays a step early, within the bounds.
     void planAsGpu(bool asGpu) { planAsGpu_ = asGpu; }
+    // With false, the driver specialises the kernel as compiled; by default
+    // its constants are folded in first, where the context keeps a cache
+    // (vulkan/SpecialisedModule.h). The image is the same either way.
+    void foldSpecialisation(bool fold) { foldSpecialisation_ = fold; }
+    bool kernelFolded() const;  // the last render's kernel had its specialisation folded in
 
 private:
     struct Pipeline;
@@ -129,6 +134,7 @@ private:
     std::array<VkBufferView, SNELL_BINDING_COUNT> sceneViews_{};
     bool plansForCpu() const { return context_.isCpuDevice() && !planAsGpu_; }
     bool planAsGpu_ = false;
+    bool foldSpecialisation_ = true;
     std::uint32_t loopBudget_ = 0;  // where the driver ends long loops (gpu/DriverProbe.h), else 0
     bool countLanes_ = false;
     double uploadMs_ = 0.0;

@@ -439,6 +439,10 @@ void Context::openPipelineCache(const std::string& path) {
 
 Context::~Context() { release(); }
 
+std::string Context::cacheDirectory() const {
+    return pipelineCachePath_.empty() ? std::string() : std::filesystem::path(pipelineCachePath_).parent_path().string();
+}
+
 void Context::savePipelineCache() {
     // Best effort: a cache that cannot be written only makes the next start slower.
     std::size_t size = 0;

@@ -152,6 +152,9 @@ public:
 
     // The pipeline cache (VK_NULL_HANDLE when none could be made).
     VkPipelineCache pipelineCache() const { return pipelineCache_; }
+    // Where the run keeps what it compiles (the pipeline cache's directory);
+    // empty: nothing is kept.
+    std::string cacheDirectory() const;
 
     // vkQueueSubmit on the context's queue (through the fault-injection hook).
     VkResult submit(const VkSubmitInfo& info, VkFence fence);
