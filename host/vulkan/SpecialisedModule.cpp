@@ -19,7 +19,7 @@ namespace fs = std::filesystem;
 constexpr std::uint32_t kSpirvMagic = 0x07230203;
 constexpr std::uint32_t kFileMagic = 0x50534e53;  // "SNSP"
 // Changes with the passes below: a file made by other passes is not used.
-constexpr std::uint32_t kFormat = 1;
+constexpr std::uint32_t kFormat = 2;
 // Modules kept; beyond it the oldest go (a specialisation is some 90 KiB).
 constexpr std::size_t kMaxKept = 256;
 
@@ -41,7 +41,7 @@ std::uint64_t keyOf(std::span<const std::uint32_t> module, std::span<const std::
 }
 
 // The words a kept file starts with: what it was made from, checked on
-// reading (a hash alone could collide).
+// reading (a hash alone could collide). The module's length follows them.
 std::vector<std::uint32_t> headerOf(std::span<const std::uint32_t> module, std::span<const std::uint32_t> values,
                                     std::uint64_t key) {
     std::vector<std::uint32_t> header{kFileMagic, kFormat, std::uint32_t(module.size()), std::uint32_t(key),
@@ -55,11 +55,14 @@ std::vector<std::uint32_t> readKept(const fs::path& path, const std::vector<std:
     if (!in) return {};
     const std::vector<char> bytes{std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
     const std::size_t words = bytes.size() / 4;
-    if (bytes.size() % 4 != 0 || words <= header.size() + 5) return {};
+    if (bytes.size() % 4 != 0 || words <= header.size() + 6) return {};
     std::vector<std::uint32_t> all(words);
     std::memcpy(all.data(), bytes.data(), bytes.size());
-    if (!std::equal(header.begin(), header.end(), all.begin()) || all[header.size()] != kSpirvMagic) return {};
-    return {all.begin() + std::ptrdiff_t(header.size()), all.end()};
+    const std::size_t start = header.size() + 1;  // after the module's length
+    if (!std::equal(header.begin(), header.end(), all.begin()) || all[header.size()] != words - start ||
+        all[start] != kSpirvMagic)
+        return {};  // another module's, or cut short
+    return {all.begin() + std::ptrdiff_t(start), all.end()};
 }
 
 // The constants fixed, then the branches, functions and code they make dead
@@ -94,7 +97,9 @@ void keep(const fs::path& directory, const fs::path& path, const std::vector<std
     const fs::path temporary = path.string() + ".tmp-" + std::to_string(::getpid());
     {
         std::ofstream out(temporary, std::ios::binary);
+        const std::uint32_t length = std::uint32_t(folded.size());
         out.write(reinterpret_cast<const char*>(header.data()), std::streamsize(header.size() * 4));
+        out.write(reinterpret_cast<const char*>(&length), sizeof length);
         out.write(reinterpret_cast<const char*>(folded.data()), std::streamsize(folded.size() * 4));
         if (!out) {
             fs::remove(temporary, ignored);
