@@ -129,7 +129,7 @@ struct TruncationReport {
     std::uint64_t estimated = 0;     // unbounded pixels stopped by their estimated error (ErrorEstimate)
     std::uint64_t droppedGrowing = 0; // unbounded pixels, over the tolerance and unestimated, that dropped
                                       // light that may grow for want of room (the GPU's frontier or stack)
-    double maxEstimate = 0.0;        // the largest estimated error of those
+    double maxEstimate = 0.0;        // the largest estimated error of the estimated pixels
     int deepest = 0;                 // the deepest ray traced (generations below the primary ray)
     static constexpr std::size_t kExamples = 8;
     std::vector<std::array<int, 2>> unboundedExamples;   // the first few, (x, y)
