@@ -56,6 +56,26 @@ MESA_SHADER_CACHE_DIR="${MESA_SHADER_CACHE_DIR:-$HOME/.cache/mesa_shader_cache}"
 grep -q '"kernel": "driver"' "$work/stats" && cmp -s "$work/driver.pfm" "$work/folded.pfm" && ok ||
   bad "without a cache: $(cat "$work/stats")"
 
+# Where the device has shader objects and validation is off, the kernel is one
+# whose driver binary is kept: the next run starts from that binary, with the
+# same image; elsewhere it is a pipeline.
+rm -rf "$SNELL_CACHE_DIR/shaders"
+for run in first second; do
+  SNELL_VALIDATION=0 "$SNELL" render "$SCENES/glass.scn" --size 24 -q -o "$work/$run.pfm" --stats 2>/dev/null |
+    tail -n 1 >"$work/stats-$run"
+done
+if "$SNELL" devices | grep -q "kernels: kept driver binaries"; then
+  grep -q '"kernel_object": "shader object"' "$work/stats-first" && ok || bad "first run: $(cat "$work/stats-first")"
+  grep -q '"kernel_object": "shader binary"' "$work/stats-second" && ls "$SNELL_CACHE_DIR"/shaders/*.bin >/dev/null 2>&1 &&
+    ok || bad "second run: $(cat "$work/stats-second")"
+else
+  grep -q '"kernel_object": "pipeline"' "$work/stats-second" && ok || bad "no shader objects: $(cat "$work/stats-second")"
+fi
+cmp -s "$work/first.pfm" "$work/folded.pfm" && cmp -s "$work/second.pfm" "$work/folded.pfm" && ok ||
+  bad "the kernel's binary traced another image"
+SNELL_VALIDATION=1 "$SNELL" render "$SCENES/glass.scn" --size 24 -q -o "$work/validated.pfm" --stats 2>/dev/null |
+  tail -n 1 | grep -q '"kernel_object": "pipeline"' && ok || bad "shader objects under validation"
+
 # No Vulkan driver at all: status 1, a message naming the package, no file.
 VK_ICD_FILENAMES=/nonexistent/icd.json "$SNELL" render "$SCENES/basic.scn" -o "$work/nodev.png" 2>"$work/err"; status=$?
 [ $status -eq 1 ] && grep -q "mesa-vulkan-drivers" "$work/err" && [ ! -e "$work/nodev.png" ] && ok || bad "no Vulkan driver ($status): $(cat "$work/err")"

@@ -11,30 +11,20 @@
 #include <memory>
 #include <string>
 
+#include "temporary_directory.h"
 #include "vulkan/VulkanContext.h"
 
 namespace snell::testing {
 
-// A cache directory of the test executable's own, removed at its end: the
-// kernels are specialised as a render with a cache specialises them
-// (vulkan/SpecialisedModule.h).
-struct TemporaryCache {
-    std::string directory;
-    TemporaryCache() {
-        char name[] = "/tmp/snell-test-cache-XXXXXX";
-        if (::mkdtemp(name)) directory = name;
-    }
-    ~TemporaryCache() {
-        std::error_code ignored;
-        if (!directory.empty()) std::filesystem::remove_all(directory, ignored);
-    }
-};
 
 inline vk::Context& gpuContext() {
-    static TemporaryCache cache;
+    // A cache directory of the test executable's own: the kernels are
+    // specialised as a render with a cache specialises them
+    // (vulkan/SpecialisedModule.h).
+    static TemporaryDirectory cache;
     static std::unique_ptr<vk::Context> context = [] {
         vk::ContextOptions options;
-        if (!cache.directory.empty()) options.pipelineCachePath = cache.directory + "/pipelines.bin";
+        if (!cache.path().empty()) options.pipelineCachePath = cache.path() + "/pipelines.bin";
         const char* validation = std::getenv("SNELL_VALIDATION");
         options.validation = validation && std::string(validation) == "1";
         options.rayQueries = vk::RayQueries::On;

@@ -565,6 +565,53 @@ TEST(GpuSpecialisation, FoldedKernelTracesTheSameImage) {
     }
 }
 
+// Where the device has shader objects, a kernel is one whose driver binary is
+// kept (vulkan/ShaderObject.h): made from SPIR-V the first time, from the
+// binary after that, tracing the pipeline's image bit for bit both times.
+// The validation layer of Debian 12 cannot check shader objects, so this
+// context runs without it, whatever SNELL_VALIDATION says.
+TEST(GpuShaderObjects, KeptBinaryTracesThePipelinesImage) {
+    snell::testing::TemporaryDirectory cache;
+    ASSERT_FALSE(cache.path().empty());
+    snell::vk::ContextOptions options;
+    options.pipelineCachePath = cache.path() + "/pipelines.bin";
+    snell::vk::Context objects(options);
+    const snell::vk::ShaderObjects& support = objects.shaderObjects();
+    if (!support.enabled) {
+        EXPECT_NE(support.absence.find("the device lacks"), std::string::npos) << support.absence;
+    }
+    const fs::path shaders = fs::path(cache.path()) / "shaders";
+    struct Case {
+        const char* file;
+        snell::gpu::Precision precision;
+    };
+    for (const Case& c : {Case{SNELL_SOURCE_DIR "/scenes/basic.scn", snell::gpu::Precision::Fp32},
+                          Case{SNELL_SOURCE_DIR "/scenes/glass.scn", snell::gpu::Precision::Fp32},
+                          Case{SNELL_SOURCE_DIR "/scenes/grid.scn", snell::gpu::Precision::Fp32},
+                          Case{SNELL_SOURCE_DIR "/scenes/hard/glass-in-water-gap-0.scn", snell::gpu::Precision::Fp32},
+                          Case{SNELL_SOURCE_DIR "/scenes/glass.scn", snell::gpu::Precision::Fp64}}) {
+        SCOPED_TRACE(c.file);
+        if (c.precision == snell::gpu::Precision::Fp64 && !objects.float64Supported()) continue;
+        const snell::Scene scene = snell::parseSceneFile(c.file);
+        const snell::RenderRequest request = wholeImage(scene, 96);
+        snell::ComputeRenderer pipeline(objects, scene, request.camera, c.precision);
+        pipeline.useShaderObjects(false);
+        const snell::GpuRenderResult own = pipeline.render(request, false);
+        EXPECT_STREQ(pipeline.kernelObject(), "pipeline");
+        for (const char* expected : {"shader object", "shader binary"}) {
+            snell::ComputeRenderer renderer(objects, scene, request.camera, c.precision);
+            const snell::GpuRenderResult image = renderer.render(request, false);
+            EXPECT_STREQ(renderer.kernelObject(), support.enabled ? expected : "pipeline");
+            ASSERT_EQ(image.image.rgb.size(), own.image.rgb.size());
+            EXPECT_EQ(pixelsThatDiffer(own.image, image.image), 0u)
+                << "pixels that differ between the pipeline and the " << renderer.kernelObject();
+        }
+        if (support.enabled) {
+            EXPECT_FALSE(fs::is_empty(shaders)) << "no binary kept";
+        }
+    }
+}
+
 TEST(GpuPlan, TracesTheImageOfLavapipesPlan) {
     for (const char* file : {SNELL_SOURCE_DIR "/scenes/grid.scn", SNELL_SOURCE_DIR "/scenes/glass.scn"}) {
         SCOPED_TRACE(file);

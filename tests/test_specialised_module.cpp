@@ -13,6 +13,7 @@
 #include "shared_layout.h"
 #include "store_kernel_comp_spv.h"
 #include "trace_comp_spv.h"
+#include "temporary_directory.h"
 #include "vulkan/SpecialisedModule.h"
 
 namespace fs = std::filesystem;
@@ -22,21 +23,7 @@ namespace {
 
 constexpr std::uint32_t kSpirvMagic = 0x07230203;
 
-class TemporaryDirectory {
-public:
-    TemporaryDirectory() {
-        char name[] = "/tmp/snell-module-test-XXXXXX";
-        if (::mkdtemp(name)) path_ = name;
-    }
-    ~TemporaryDirectory() {
-        std::error_code ignored;
-        fs::remove_all(path_, ignored);
-    }
-    const std::string& path() const { return path_; }
-
-private:
-    std::string path_;
-};
+using snell::testing::TemporaryDirectory;
 
 std::size_t modulesKept(const std::string& directory) {
     std::error_code none;

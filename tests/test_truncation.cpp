@@ -97,6 +97,47 @@ TEST(GrowthTraps, TheMediumAroundIsTheSphereThatContainsIt) {
               (std::vector<bool>{false, true}));
 }
 
+// The "had not settled" warning names only the unbounded pixels that claim no
+// estimate and dropped no growing light; each kind keeps its own examples.
+TEST(TruncationReport, ExamplesOfEachKindOfPixel) {
+    snell::TruncationReport report;
+    auto pixel = [](int x, bool unbounded) {
+        snell::PixelTruncation p;
+        p.x = x;
+        p.y = 7;
+        p.bound = unbounded ? 0.0 : 0.25;
+        p.unbounded = unbounded;
+        return p;
+    };
+    snell::PixelTruncation estimated = pixel(1, true);
+    estimated.estimated = true;
+    estimated.estimatedError = 0.003;
+    snell::PixelTruncation dropped = pixel(2, true);
+    dropped.overTolerance = dropped.droppedGrowing = true;
+    snell::PixelTruncation unsettled = pixel(3, true);
+    unsettled.overTolerance = true;
+    snell::PixelTruncation overBudget = pixel(4, false);
+    overBudget.overBudget = true;
+    for (const auto& p : {estimated, dropped, pixel(0, false), unsettled, overBudget}) report.add(p);
+    EXPECT_EQ(report.pixels, 5u);
+    EXPECT_EQ(report.unbounded, 3u);
+    EXPECT_EQ(report.estimated, 1u);
+    EXPECT_EQ(report.droppedGrowing, 1u);
+    EXPECT_EQ(report.overTolerance, 2u);
+    EXPECT_EQ(report.unsettled(), 1u);
+    EXPECT_DOUBLE_EQ(report.maxEstimate, 0.003);
+    EXPECT_DOUBLE_EQ(report.maxBound, 0.25);
+    using Examples = std::vector<std::array<int, 2>>;
+    EXPECT_EQ(report.unsettledExamples, (Examples{{3, 7}}));
+    EXPECT_EQ(report.droppedGrowingExamples, (Examples{{2, 7}}));
+    EXPECT_EQ(report.overBudgetExamples, (Examples{{4, 7}}));
+    snell::TruncationReport merged;
+    merged.merge(report);
+    merged.merge(report);
+    EXPECT_EQ(merged.unsettled(), 2u);
+    EXPECT_EQ(merged.unsettledExamples, (Examples{{3, 7}, {3, 7}}));
+}
+
 TEST(PixelEstimate, ClampedToTheHeadroomAndZeroWhenSaturated) {
     snell::RadianceBound b;
     b.radiance = glm::dvec3(2.0, std::numeric_limits<double>::infinity(), 1.0);

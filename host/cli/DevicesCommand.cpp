@@ -15,6 +15,12 @@ std::string traversal(const vk::DeviceReport& r) {
                            : "; traversal: ray-query (--traversal bvh for snell's walk)";
 }
 
+// How the device's kernels start: from driver binaries kept by earlier runs, or as pipelines.
+std::string kernels(const vk::DeviceReport& r) {
+    return r.shaderObjects ? "; kernels: kept driver binaries (VK_EXT_shader_object)"
+                           : "; kernels: pipelines (no VK_EXT_shader_object)";
+}
+
 class DevicesCommand : public Command {
 public:
     CLI::App* define(CLI::App& app) override {
@@ -27,7 +33,7 @@ public:
         for (const auto& r : reports)
             std::cout << r.index << ": " << r.name << " (" << r.type << ", " << r.driver << ")"
                       << (r.usable ? "" : " — unusable: " + r.reason)
-                      << (r.usable ? traversal(r) : "")
+                      << (r.usable ? traversal(r) + kernels(r) : "")
                       << (r.usable && !r.fp64Refusal.empty() ? "; no --precision fp64: " + r.fp64Refusal : "") << "\n";
         return kExitSuccess;
     }

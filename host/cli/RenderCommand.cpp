@@ -65,12 +65,12 @@ void printTruncationWarnings(const TruncationReport& t, const TraceSettings& set
         if (count > pixels.size()) s += ", ...";
         return ", e.g. " + s;
     };
-    if (t.unbounded > t.estimated + t.droppedGrowing)
-        std::cerr << "snell: warning: " << t.unbounded - t.estimated - t.droppedGrowing
+    if (t.unsettled() > 0)
+        std::cerr << "snell: warning: " << t.unsettled()
                   << " pixel(s) dropped light of a material with ks + kt >= 1, which need not decay, and their "
                   << "colour had not settled at the floor cut-off " << settings.minWeight
                   << ": the image is not certified there (--bound-image shows where); a lower --min-weight "
-                  << "traces them further" << examples(t.unboundedExamples, t.unbounded) << "\n";
+                  << "traces them further" << examples(t.unsettledExamples, t.unsettled()) << "\n";
     if (t.droppedGrowing > 0)
         std::cerr << "snell: warning: " << t.droppedGrowing << " pixel(s) dropped light trapped in a material "
                   << "with ks + kt > 1, which may grow, for want of room to keep it for their next step: their "
@@ -106,6 +106,7 @@ struct RenderOutcome {
     std::string device;
     std::string traversal = "reference";  // ComputeRenderer::traversal() on the GPU
     std::string kernel = "reference";     // on the GPU: "folded" (its specialisation folded in) or "driver"
+    std::string kernelObject = "none";    // on the GPU: ComputeRenderer::kernelObject()
     std::string timing = "host";  // how renderMs was measured
     double uploadMs = 0, pipelineMs = 0, renderMs = 0, readbackMs = 0;
     double estimateMs = 0;  // the progress bar's sparse render (estimateCost)
@@ -453,6 +454,7 @@ RenderOutcome RenderCommand::renderOnGpu(const Scene& scene, RenderRequest& requ
         r.device = context.deviceName();
         r.traversal = renderer.traversal();
         r.kernel = renderer.kernelFolded() ? "folded" : "driver";
+        r.kernelObject = renderer.kernelObject();
         r.uploadMs = renderer.uploadMs();
         r.rays = g.rays;
         r.renderMs = g.renderMs;
@@ -496,7 +498,7 @@ std::string RenderCommand::statsJson(const Scene& scene, const RenderRequest& re
       << ", \"backend\": \"" << (o_.cpu ? "cpu" : "gpu") << "\", \"device\": " << jsonString(r.device)
       << ", \"precision\": \"" << (o_.cpu ? "fp64-reference" : o_.device.precision) << "\""
       << ", \"traversal\": \"" << r.traversal << "\""
-      << ", \"kernel\": \"" << r.kernel << "\""
+      << ", \"kernel\": \"" << r.kernel << "\", \"kernel_object\": \"" << r.kernelObject << "\""
       << ", \"width\": " << request.width << ", \"height\": " << request.height
       << ", \"supersample\": " << request.supersample << ", \"max_depth\": " << request.trace.maxDepth
       << ", \"min_weight\": " << request.trace.minWeight << ", \"spheres\": " << scene.spheres.size()

@@ -52,6 +52,7 @@ struct ComputeRenderer::Pipeline {
     VkDescriptorSetLayout setLayout = VK_NULL_HANDLE;
     VkPipelineLayout layout = VK_NULL_HANDLE;
     VkPipeline pipeline = VK_NULL_HANDLE;
+    vk::ComputeShader shader;  // instead of the pipeline, where the device has shader objects
     VkShaderModule module = VK_NULL_HANDLE;
     VkDescriptorPool pool = VK_NULL_HANDLE;
     VkDescriptorSet set = VK_NULL_HANDLE;
@@ -256,13 +257,37 @@ ComputeRenderer::Specialisation ComputeRenderer::specialise(const RenderRequest&
     return values;
 }
 
-// The pipeline object alone, for p's module, layout and specialisation.
-void ComputeRenderer::createComputePipeline(Pipeline& p) {
+// The kernel alone, for p's module, layout and specialisation: a shader
+// object from its kept binary where the device has them and the run keeps a
+// cache, else a pipeline.
+void ComputeRenderer::createComputePipeline(Pipeline& p, std::span<const std::uint32_t> code) {
     std::array<VkSpecializationMapEntry, SNELL_SPEC_COUNT> entries{};
     for (std::uint32_t i = 0; i < entries.size(); ++i)
         entries[i] = {i, i * static_cast<std::uint32_t>(sizeof(std::uint32_t)), sizeof(std::uint32_t)};
     VkSpecializationInfo spec{static_cast<std::uint32_t>(entries.size()), entries.data(),
                               p.values.size() * sizeof(std::uint32_t), p.values.data()};
+    const vk::ShaderObjects& objects = context_.shaderObjects();
+    const std::string cacheDirectory = context_.cacheDirectory();
+    if (objects.enabled && useShaderObjects_ && !cacheDirectory.empty()) {
+        std::vector<std::uint32_t> layoutWords;
+        for (std::uint32_t binding : p.bindings) {
+            layoutWords.push_back(binding);
+            layoutWords.push_back(std::uint32_t(descriptorType(binding)));
+        }
+        vk::ComputeShaderInfo info;
+        info.spirv = code;
+        info.setLayout = p.setLayout;
+        info.setLayoutWords = layoutWords;
+        info.pushConstants = {VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(gpu::TileParams)};
+        info.specialisation = p.folded ? nullptr : &spec;
+        info.specialisationWords = p.values;
+        p.shader = vk::createComputeShader(context_.device(), objects, info, cacheDirectory);
+        return;
+    }
+    VkShaderModuleCreateInfo moduleInfo{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
+    moduleInfo.codeSize = code.size_bytes();
+    moduleInfo.pCode = code.data();
+    check(vkCreateShaderModule(context_.device(), &moduleInfo, nullptr, &p.module), "vkCreateShaderModule");
     VkComputePipelineCreateInfo pipelineInfo{VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO};
     pipelineInfo.stage = {VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO};
     pipelineInfo.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
@@ -311,15 +336,9 @@ void ComputeRenderer::createPipeline(const Specialisation& values, Pipeline& p) 
         foldSpecialisation_ ? vk::specialisedModule(compiled, values, context_.cacheDirectory())
                             : std::vector<std::uint32_t>();
     p.folded = !folded.empty();
-    const Words code = p.folded ? Words(folded) : compiled;
-    VkShaderModuleCreateInfo moduleInfo{VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO};
-    moduleInfo.codeSize = code.size_bytes();
-    moduleInfo.pCode = code.data();
-    check(vkCreateShaderModule(device, &moduleInfo, nullptr, &p.module), "vkCreateShaderModule");
-
     p.rayEntries = values[SNELL_SPEC_RAY_STACK] + values[SNELL_SPEC_FRONTIER];
     p.maxMedia = values[SNELL_SPEC_MAX_MEDIA];
-    createComputePipeline(p);
+    createComputePipeline(p, p.folded ? Words(folded) : compiled);
 
     std::vector<VkDescriptorPoolSize> sizes;
     for (std::uint32_t binding : p.bindings) {
@@ -366,6 +385,7 @@ void ComputeRenderer::destroyPipeline(Pipeline& p) {
     if (p.commandPool) vkDestroyCommandPool(device, p.commandPool, nullptr);
     if (p.pool) vkDestroyDescriptorPool(device, p.pool, nullptr);
     if (p.pipeline) vkDestroyPipeline(device, p.pipeline, nullptr);
+    if (p.shader.shader) context_.shaderObjects().destroy(device, p.shader.shader, nullptr);
     if (p.module) vkDestroyShaderModule(device, p.module, nullptr);
     if (p.layout) vkDestroyPipelineLayout(device, p.layout, nullptr);
     if (p.setLayout) vkDestroyDescriptorSetLayout(device, p.setLayout, nullptr);
@@ -564,6 +584,12 @@ ComputeRenderer::TilePlan ComputeRenderer::planTiles(const RenderRequest& reques
 
 bool ComputeRenderer::kernelFolded() const { return cached_ && cached_->folded; }
 
+const char* ComputeRenderer::kernelObject() const {
+    if (!cached_) return "none";
+    if (!cached_->shader.shader) return "pipeline";
+    return cached_->shader.fromBinary ? "shader binary" : "shader object";
+}
+
 ComputeRenderer::Pipeline& ComputeRenderer::ensurePipeline(const Specialisation& values, bool& created) {
     // The pipeline of the last render serves again when the specialisation
     // is the same, and its buffers when they are large enough (the preview).
@@ -691,6 +717,17 @@ void ComputeRenderer::submit(Pipeline& p, Progress& progress, bool timed, bool r
     }
 }
 
+// The kernel (shader object or pipeline) and its descriptor set.
+void ComputeRenderer::bindKernel(VkCommandBuffer cmd, const Pipeline& p) const {
+    if (p.shader.shader) {
+        const VkShaderStageFlagBits stage = VK_SHADER_STAGE_COMPUTE_BIT;
+        context_.shaderObjects().bind(cmd, 1, &stage, &p.shader.shader);
+    } else {
+        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.pipeline);
+    }
+    vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.layout, 0, 1, &p.set, 0, nullptr);
+}
+
 // An empty dispatch: llvmpipe compiles a shader at its first dispatch, and
 // that belongs to pipeline creation, not to the render.
 void ComputeRenderer::firstDispatch(Pipeline& p) {
@@ -698,8 +735,7 @@ void ComputeRenderer::firstDispatch(Pipeline& p) {
     std::memset(p.counters.mapped, 0, SNELL_COUNTER_COUNT * sizeof(std::uint32_t));
     Progress untimed;
     submit(p, untimed, false, false, [&](VkCommandBuffer cmd) {
-        vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.pipeline);
-        vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.layout, 0, 1, &p.set, 0, nullptr);
+        bindKernel(cmd, p);
         vkCmdPushConstants(cmd, p.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof empty, &empty);
         vkCmdDispatch(cmd, 1, 1, 1);
     });
@@ -837,8 +873,7 @@ void ComputeRenderer::dispatchTile(Pipeline& p, const RenderRequest& request, co
         tile.resume = pass > 0 ? 1u : 0u;
         if (pass == 0) std::memset(p.slotStates.mapped, 0, plan.invocations * sizeof(gpu::SlotState));
         submit(p, progress, true, pass > 0, [&](VkCommandBuffer cmd) {
-            vkCmdBindPipeline(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.pipeline);
-            vkCmdBindDescriptorSets(cmd, VK_PIPELINE_BIND_POINT_COMPUTE, p.layout, 0, 1, &p.set, 0, nullptr);
+            bindKernel(cmd, p);
             vkCmdPushConstants(cmd, p.layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof tile, &tile);
             vkCmdDispatch(cmd, groups, 1, 1);
             memoryBarrier(cmd, VK_ACCESS_SHADER_WRITE_BIT, VK_ACCESS_HOST_READ_BIT,
@@ -893,10 +928,17 @@ void ComputeRenderer::readBackTile(const Pipeline& p, const RenderRequest& reque
             row[column * 3 + 2] = out.colour.b;
             // The pixel's truncation bound, negative where not finite.
             const float bound = std::abs(out.colour.a);
-            truncation.addPixel(imageX, imageY, bound, out.colour.a < 0.0f, out.truncation.y != 0.0f);
-            if (out.truncation.x >= 0.0f) truncation.addEstimate(out.truncation.x);
-            if (out.truncation.z != 0.0f) ++truncation.overTolerance;
-            if (out.truncation.z == 2.0f) truncation.addDroppedGrowing(imageX, imageY);
+            PixelTruncation pixel;
+            pixel.x = imageX;
+            pixel.y = imageY;
+            pixel.bound = bound;
+            pixel.unbounded = out.colour.a < 0.0f;
+            pixel.overBudget = out.truncation.y != 0.0f;
+            pixel.overTolerance = out.truncation.z != 0.0f;
+            pixel.estimated = out.truncation.x >= 0.0f;
+            pixel.estimatedError = std::max(0.0f, out.truncation.x);
+            pixel.droppedGrowing = out.truncation.z == 2.0f;
+            truncation.add(pixel);
             if (request.boundImage)
                 (*request.boundImage)[std::size_t(windowRow) * area.width() + column] = bound;
             if (request.rayImage)

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <span>
 
 #include "gpu/GpuScene.h"
 #include "image/Image.h"
@@ -97,6 +98,12 @@ public:
     // (vulkan/SpecialisedModule.h). The image is the same either way.
     void foldSpecialisation(bool fold) { foldSpecialisation_ = fold; }
     bool kernelFolded() const;  // the last render's kernel had its specialisation folded in
+    // With false, the kernel is a pipeline even where the device has shader
+    // objects (vulkan/ShaderObject.h). The image is the same either way.
+    void useShaderObjects(bool use) { useShaderObjects_ = use; }
+    // The last render's kernel: "pipeline", "shader object" (made from its
+    // SPIR-V, its binary kept), or "shader binary" (from a kept binary).
+    const char* kernelObject() const;
 
 private:
     struct Pipeline;
@@ -105,7 +112,8 @@ private:
     using Specialisation = std::array<std::uint32_t, SNELL_SPEC_COUNT>;
     Specialisation specialise(const RenderRequest& request, bool countRays) const;
     void createPipeline(const Specialisation& values, Pipeline& pipeline);
-    void createComputePipeline(Pipeline& pipeline);
+    void createComputePipeline(Pipeline& pipeline, std::span<const std::uint32_t> code);
+    void bindKernel(VkCommandBuffer cmd, const Pipeline& pipeline) const;
     void destroyPipeline(Pipeline& pipeline);
     // The phases of render(), in order.
     TilePlan planTiles(const RenderRequest& request, const Specialisation& values) const;
@@ -135,6 +143,7 @@ private:
     bool plansForCpu() const { return context_.isCpuDevice() && !planAsGpu_; }
     bool planAsGpu_ = false;
     bool foldSpecialisation_ = true;
+    bool useShaderObjects_ = true;
     std::uint32_t loopBudget_ = 0;  // where the driver ends long loops (gpu/DriverProbe.h), else 0
     bool countLanes_ = false;
     double uploadMs_ = 0.0;

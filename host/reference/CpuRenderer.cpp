@@ -501,9 +501,16 @@ Image CpuRenderer::render(const RenderRequest& request, RayCounts* counts) const
                     const Pixel pixel = renderPixel(request, x, y, local);
                     const dvec3 c = pixel.colour;
                     TruncationReport& t = truncation[id];
-                    t.addPixel(x, y, pixel.bound, pixel.unbounded, pixel.overBudget);
-                    t.overTolerance += pixel.overTolerance;
-                    if (pixel.estimated) t.addEstimate(pixel.estimatedError);
+                    PixelTruncation outcome;
+                    outcome.x = x;
+                    outcome.y = y;
+                    outcome.bound = pixel.bound;
+                    outcome.unbounded = pixel.unbounded;
+                    outcome.overBudget = pixel.overBudget;
+                    outcome.overTolerance = pixel.overTolerance;
+                    outcome.estimated = pixel.estimated;
+                    outcome.estimatedError = pixel.estimatedError;
+                    t.add(outcome);
                     t.deepest = std::max(t.deepest, pixel.deepest);
                     if (request.boundImage)
                         (*request.boundImage)[static_cast<std::size_t>(row) * width + column] =

@@ -189,28 +189,26 @@ TreeSizeBound treeSizeBound(const Scene& scene, int maxDepth, double minWeight) 
     return b;
 }
 
-void TruncationReport::addPixel(int x, int y, double bound, bool isUnbounded, bool isOverBudget) {
-    maxBound = std::max(maxBound, bound);
-    sumBound += bound;
+void TruncationReport::add(const PixelTruncation& p) {
+    maxBound = std::max(maxBound, p.bound);
+    sumBound += p.bound;
     ++pixels;
-    if (isUnbounded) {
-        ++unbounded;
-        if (unboundedExamples.size() < kExamples) unboundedExamples.push_back({x, y});
+    overTolerance += p.overTolerance;
+    if (p.unbounded) ++unbounded;
+    if (p.estimated) {
+        ++estimated;
+        maxEstimate = std::max(maxEstimate, p.estimatedError);
     }
-    if (isOverBudget) {
+    if (p.droppedGrowing) {
+        ++droppedGrowing;
+        if (droppedGrowingExamples.size() < kExamples) droppedGrowingExamples.push_back({p.x, p.y});
+    }
+    if (p.unbounded && !p.estimated && !p.droppedGrowing && unsettledExamples.size() < kExamples)
+        unsettledExamples.push_back({p.x, p.y});
+    if (p.overBudget) {
         ++overBudget;
-        if (overBudgetExamples.size() < kExamples) overBudgetExamples.push_back({x, y});
+        if (overBudgetExamples.size() < kExamples) overBudgetExamples.push_back({p.x, p.y});
     }
-}
-
-void TruncationReport::addEstimate(double error) {
-    ++estimated;
-    maxEstimate = std::max(maxEstimate, error);
-}
-
-void TruncationReport::addDroppedGrowing(int x, int y) {
-    ++droppedGrowing;
-    if (droppedGrowingExamples.size() < kExamples) droppedGrowingExamples.push_back({x, y});
 }
 
 void TruncationReport::merge(const TruncationReport& o) {
@@ -224,8 +222,8 @@ void TruncationReport::merge(const TruncationReport& o) {
     overBudget += o.overBudget;
     overTolerance += o.overTolerance;
     deepest = std::max(deepest, o.deepest);
-    for (const auto& e : o.unboundedExamples)
-        if (unboundedExamples.size() < kExamples) unboundedExamples.push_back(e);
+    for (const auto& e : o.unsettledExamples)
+        if (unsettledExamples.size() < kExamples) unsettledExamples.push_back(e);
     for (const auto& e : o.overBudgetExamples)
         if (overBudgetExamples.size() < kExamples) overBudgetExamples.push_back(e);
     for (const auto& e : o.droppedGrowingExamples)

@@ -7,6 +7,7 @@
 // SPEC §6's clamp, in [value, min(1, value + w·R)].
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <limits>
@@ -118,6 +119,18 @@ struct TreeSizeBound {
 };
 TreeSizeBound treeSizeBound(const Scene& scene, int maxDepth, double minWeight);
 
+// How a pixel's tree ended, as its renderer reports it.
+struct PixelTruncation {
+    int x = 0, y = 0;
+    double bound = 0.0;           // the bound on its lost light
+    bool unbounded = false;       // that light has no finite bound
+    bool overBudget = false;      // stopped by the tree budget, not finished
+    bool overTolerance = false;   // still above the tolerance at the floor cut-off
+    bool estimated = false;       // unbounded, stopped by its estimated error (ErrorEstimate)
+    double estimatedError = 0.0;
+    bool droppedGrowing = false;  // dropped light that may grow for want of room (the GPU's frontier or stack)
+};
+
 // A render's truncation, summed over its pixels.
 struct TruncationReport {
     double maxBound = 0.0;
@@ -132,14 +145,17 @@ struct TruncationReport {
     double maxEstimate = 0.0;        // the largest estimated error of the estimated pixels
     int deepest = 0;                 // the deepest ray traced (generations below the primary ray)
     static constexpr std::size_t kExamples = 8;
-    std::vector<std::array<int, 2>> unboundedExamples;   // the first few, (x, y)
+    // The first few, (x, y), of the unbounded pixels that neither claim an
+    // estimate nor dropped growing light (their colour had not settled), of
+    // those over budget, and of those that dropped growing light.
+    std::vector<std::array<int, 2>> unsettledExamples;
     std::vector<std::array<int, 2>> overBudgetExamples;
     std::vector<std::array<int, 2>> droppedGrowingExamples;
 
     double meanBound() const { return pixels ? sumBound / double(pixels) : 0.0; }
-    void addPixel(int x, int y, double bound, bool isUnbounded, bool isOverBudget);
-    void addEstimate(double error);  // the pixel just added was stopped by its estimated error
-    void addDroppedGrowing(int x, int y);
+    // Unbounded pixels that neither claim an estimate nor dropped growing light.
+    std::uint64_t unsettled() const { return unbounded - std::min(unbounded, estimated + droppedGrowing); }
+    void add(const PixelTruncation& pixel);
     void merge(const TruncationReport& other);
 };
 

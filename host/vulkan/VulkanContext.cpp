@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <type_traits>
 
 #include <unistd.h>
 
@@ -86,6 +87,15 @@ bool supportsRayQueries(VkPhysicalDevice device, std::string& why) {
     return true;
 }
 
+// Whether the device has shader objects (the extension and its feature).
+bool supportsShaderObjects(VkPhysicalDevice device, const std::vector<VkExtensionProperties>& available) {
+    if (!hasExtension(available, VK_EXT_SHADER_OBJECT_EXTENSION_NAME)) return false;
+    VkPhysicalDeviceShaderObjectFeaturesEXT objects{kStructureTypePhysicalDeviceShaderObjectFeatures};
+    VkPhysicalDeviceFeatures2 features{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &objects};
+    vkGetPhysicalDeviceFeatures2(device, &features);
+    return objects.shaderObject;
+}
+
 DeviceReport examine(VkPhysicalDevice device, int index, std::uint32_t& family,
                      const std::vector<std::string>& extensions) {
     DeviceReport report;
@@ -142,6 +152,7 @@ DeviceReport examine(VkPhysicalDevice device, int index, std::uint32_t& family,
     report.usable = true;
     std::string ignored;
     report.rayQueries = supportsRayQueries(device, ignored);
+    report.shaderObjects = supportsShaderObjects(device, available);
     report.fp64Refusal = Context::fp64RefusalFor(driver.driverID);
     return report;
 }
@@ -319,7 +330,11 @@ Context::Context(const ContextOptions& options) : fault_(options.fault) {
         vkGetPhysicalDeviceQueueFamilyProperties(physical_, &count, qf.data());
         timestampValidBits_ = qf[queueFamily_].timestampValidBits;
 
-        createDevice(options.deviceExtensions, options.rayQueries);
+        createDevice(options.deviceExtensions, options.rayQueries, options.shaderObjects && !options.validation);
+        if (!shaderObjects_.enabled && shaderObjects_.absence.empty())
+            shaderObjects_.absence = options.shaderObjects
+                                         ? "validation is on, and Debian 12's validation layer cannot check shader objects"
+                                         : "shader objects were not asked for";
         openPipelineCache(options.pipelineCachePath);
     } catch (...) {
         release();
@@ -373,7 +388,7 @@ int Context::chooseDevice(const std::vector<VkPhysicalDevice>& devices, const Co
 // The logical device with one compute queue, shader doubles where the device
 // has them, ray queries where asked for and the device has them, and the
 // one-off command pool and fence.
-void Context::createDevice(const std::vector<std::string>& extensions, RayQueries rayQueries) {
+void Context::createDevice(const std::vector<std::string>& extensions, RayQueries rayQueries, bool shaderObjects) {
     VkPhysicalDeviceFeatures supported;
     vkGetPhysicalDeviceFeatures(physical_, &supported);
     VkPhysicalDeviceFeatures2 enabled{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
@@ -394,6 +409,25 @@ void Context::createDevice(const std::vector<std::string>& extensions, RayQuerie
         v12.bufferDeviceAddress = VK_TRUE;
         enabled.pNext = &v12;
     }
+    std::uint32_t extCount = 0;
+    vkEnumerateDeviceExtensionProperties(physical_, nullptr, &extCount, nullptr);
+    std::vector<VkExtensionProperties> available(extCount);
+    vkEnumerateDeviceExtensionProperties(physical_, nullptr, &extCount, available.data());
+    VkPhysicalDeviceShaderObjectFeaturesEXT objects{kStructureTypePhysicalDeviceShaderObjectFeatures};
+    if (!supportsShaderObjects(physical_, available)) {
+        shaderObjects_.absence = "the device lacks " VK_EXT_SHADER_OBJECT_EXTENSION_NAME;
+    } else if (shaderObjects) {
+        shaderObjects_.enabled = true;
+        objects.shaderObject = VK_TRUE;
+        objects.pNext = enabled.pNext;
+        enabled.pNext = &objects;
+        VkPhysicalDeviceShaderObjectPropertiesEXT properties{kStructureTypePhysicalDeviceShaderObjectProperties};
+        VkPhysicalDeviceProperties2 props2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, &properties};
+        vkGetPhysicalDeviceProperties2(physical_, &props2);
+        std::copy(std::begin(properties.shaderBinaryUUID), std::end(properties.shaderBinaryUUID),
+                  shaderObjects_.binaryUuid.begin());
+        shaderObjects_.binaryVersion = properties.shaderBinaryVersion;
+    }
     const float priority = 1.0f;
     VkDeviceQueueCreateInfo queueInfo{VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO};
     queueInfo.queueFamilyIndex = queueFamily_;
@@ -403,6 +437,7 @@ void Context::createDevice(const std::vector<std::string>& extensions, RayQuerie
     for (const std::string& e : extensions) exts.push_back(e.c_str());
     if (rayQueries_)
         for (const char* e : kRayQueryExtensions) exts.push_back(e);
+    if (shaderObjects_.enabled) exts.push_back(VK_EXT_SHADER_OBJECT_EXTENSION_NAME);
     VkDeviceCreateInfo info{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO, &enabled};
     info.queueCreateInfoCount = 1;
     info.pQueueCreateInfos = &queueInfo;
@@ -410,6 +445,16 @@ void Context::createDevice(const std::vector<std::string>& extensions, RayQuerie
     info.ppEnabledExtensionNames = exts.data();
     check(vkCreateDevice(physical_, &info, nullptr, &device_), "vkCreateDevice");
     vkGetDeviceQueue(device_, queueFamily_, 0, &queue_);
+    if (shaderObjects_.enabled) {
+        auto load = [&](auto& function, const char* name) {
+            function = reinterpret_cast<std::remove_reference_t<decltype(function)>>(vkGetDeviceProcAddr(device_, name));
+            if (!function) throw VulkanError(std::string("the driver lists VK_EXT_shader_object but lacks ") + name);
+        };
+        load(shaderObjects_.create, "vkCreateShadersEXT");
+        load(shaderObjects_.destroy, "vkDestroyShaderEXT");
+        load(shaderObjects_.binaryData, "vkGetShaderBinaryDataEXT");
+        load(shaderObjects_.bind, "vkCmdBindShadersEXT");
+    }
     VkCommandPoolCreateInfo poolInfo{VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO};
     poolInfo.flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT;
     poolInfo.queueFamilyIndex = queueFamily_;

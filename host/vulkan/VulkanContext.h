@@ -12,6 +12,8 @@
 
 #include <vulkan/vulkan.h>
 
+#include "vulkan/ShaderObject.h"
+
 namespace snell::vk {
 
 class VulkanError : public std::runtime_error {
@@ -67,6 +69,10 @@ struct ContextOptions {
     // back at the end); empty: no cache on disk.
     std::string pipelineCachePath;
     RayQueries rayQueries = RayQueries::OnGpus;
+    // Kernels as shader objects whose binaries are kept, where the device has
+    // them (vulkan/ShaderObject.h); never under validation, whose layer in
+    // Debian 12 cannot check them.
+    bool shaderObjects = true;
 };
 
 struct DeviceReport {
@@ -77,6 +83,7 @@ struct DeviceReport {
     bool usable = false;
     std::string reason;  // why it was passed over, when it was
     bool rayQueries = false;  // has ray queries and acceleration structures
+    bool shaderObjects = false;  // has VK_EXT_shader_object: kernels start from kept binaries
     std::string fp64Refusal;  // why --precision fp64 is refused here, if it is (Context::fp64Refusal)
 };
 
@@ -120,6 +127,8 @@ public:
     // not, rayQueryAbsence() says why, for a message.
     bool rayQueriesEnabled() const { return rayQueries_; }
     const std::string& rayQueryAbsence() const { return rayQueryAbsence_; }
+    // Shader objects (ContextOptions::shaderObjects): enabled, or why not.
+    const ShaderObjects& shaderObjects() const { return shaderObjects_; }
     bool isCpuDevice() const { return properties_.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU; }
     // The size of the largest device-local memory heap.
     VkDeviceSize deviceLocalBytes() const;
@@ -173,7 +182,7 @@ public:
 private:
     int chooseDevice(const std::vector<VkPhysicalDevice>& devices, const ContextOptions& options,
                      std::uint32_t& family);
-    void createDevice(const std::vector<std::string>& extensions, RayQueries rayQueries);
+    void createDevice(const std::vector<std::string>& extensions, RayQueries rayQueries, bool shaderObjects);
     void openPipelineCache(const std::string& path);
     std::uint32_t findMemoryType(std::uint32_t typeBits, VkMemoryPropertyFlags required,
                                  VkMemoryPropertyFlags preferred) const;
@@ -198,6 +207,7 @@ private:
     bool float64_ = false;
     bool rayQueries_ = false;
     std::string rayQueryAbsence_;
+    ShaderObjects shaderObjects_;
     VkDriverId driverId_{};
     VkPhysicalDeviceProperties properties_{};
     VkPhysicalDeviceMemoryProperties memory_{};
