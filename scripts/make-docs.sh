@@ -189,7 +189,10 @@ start; up to 256 are kept), and
 the driver's binary of each such kernel, where the device has shader
 objects (VK_EXT_shader_object: lavapipe of Mesa 25, recent GPU drivers); a
 kernel made from its binary skips the driver's translation of SPIR-V (on
-lavapipe, 45 ms less a start; up to 256 are kept). With
+lavapipe, 45 ms less a start; up to 256 are kept), and
+.IR probes/ ,
+whether the driver ends long shader loops (lavapipe before Mesa 24 does),
+found once by a tiny kernel. With
 .B SNELL_CACHE_DIR
 or
 .B XDG_CACHE_HOME

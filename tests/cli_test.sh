@@ -73,6 +73,17 @@ else
 fi
 cmp -s "$work/first.pfm" "$work/folded.pfm" && cmp -s "$work/second.pfm" "$work/folded.pfm" && ok ||
   bad "the kernel's binary traced another image"
+# What the driver's loop-limit probe found is kept too (lavapipe only), and a
+# damaged answer is probed again.
+if "$SNELL" --version | grep -q llvmpipe; then
+  probe=$(ls "$SNELL_CACHE_DIR"/probes/*.probe 2>/dev/null | head -n 1)
+  [ -n "$probe" ] && ok || bad "no kept probe in $SNELL_CACHE_DIR/probes"
+  if [ -n "$probe" ]; then
+    printf 'x' >>"$probe"
+    "$SNELL" render "$SCENES/basic.scn" --size 8 -q -o "$work/probed.png" || bad "render after a damaged probe"
+    case "$(tail -c 1 "$probe")" in 0 | 1) ok ;; *) bad "damaged probe not made again" ;; esac
+  fi
+fi
 SNELL_VALIDATION=1 "$SNELL" render "$SCENES/glass.scn" --size 24 -q -o "$work/validated.pfm" --stats 2>/dev/null |
   tail -n 1 | grep -q '"kernel_object": "pipeline"' && ok || bad "shader objects under validation"
 
@@ -133,19 +144,21 @@ done
 
 # A GPU that fails mid-render (simulated by the SNELL_INJECT_FAULT hook): the
 # device is lost after the first band of rows has been streamed (1100² is 2x2
-# tiles; submissions: the driver probe, the pipeline's first dispatch, then a
-# dispatch a tile, so the 6th is the last tile's), or memory runs out while
+# tiles; submissions, with a cache of its own: the driver probe, the
+# pipeline's first dispatch, then a dispatch a tile, so the 6th is the last
+# tile's), or memory runs out while
 # the render allocates its buffers. Status 1, a message saying what happened,
 # the existing output untouched, no temporary left; the validation layer sees
 # the cleanup and must stay silent.
 for fault in device-lost:6 out-of-device-memory:9; do
   echo "precious" >"$work/fault.png"
-  SNELL_INJECT_FAULT=$fault SNELL_VALIDATION=1 "$SNELL" render "$SCENES/basic.scn" --size 1100 -o "$work/fault.png" \
+  SNELL_CACHE_DIR="$work/cache-$fault" SNELL_INJECT_FAULT=$fault SNELL_VALIDATION=1 "$SNELL" render "$SCENES/basic.scn" --size 1100 -o "$work/fault.png" \
     2>"$work/err"; status=$?
   case $fault in device-lost*) want="device was lost";; *) want="ran out of memory";; esac
   [ $status -eq 1 ] && grep -q "$want" "$work/err" && grep -q "no image was written" "$work/err" &&
     ! grep -qi "validation" "$work/err" && [ "$(cat "$work/fault.png")" = "precious" ] &&
     ! ls "$work" | grep -q "fault.png." && ok || bad "$fault (status $status): $(cat "$work/err"; ls "$work")"
+  rm -rf "$work/cache-$fault"
 done
 SNELL_INJECT_FAULT=cosmic-ray "$SNELL" render "$SCENES/basic.scn" -o "$work/x.png" 2>"$work/err"; status=$?
 [ $status -eq 2 ] && grep -q "unknown fault" "$work/err" && ok || bad "bad SNELL_INJECT_FAULT ($status)"

@@ -3,13 +3,34 @@
 #include <cstring>
 #include <map>
 #include <mutex>
+#include <filesystem>
 #include <string>
+#include <vector>
 
 #include "loop_limit_probe_comp_spv.h"  // generated at build time from shaders/loop_limit_probe.comp
 #include "shared_layout.h"
 #include "vulkan/ComputeKernel.h"
+#include "vulkan/KeptFile.h"
 
 namespace snell {
+namespace {
+
+constexpr std::uint32_t kFileMagic = 0x504c4e53;  // "SNLP"
+constexpr std::uint32_t kFormat = 1;
+
+// What a kept outcome is for: the probe's format and the device and driver
+// (their names in full, so no other driver's outcome is ever read).
+std::vector<std::uint32_t> probeHeader(const std::string& key) {
+    std::vector<std::uint32_t> header{kFileMagic, kFormat, std::uint32_t(key.size())};
+    for (std::size_t i = 0; i < key.size(); i += 4) {
+        std::uint32_t word = 0;
+        for (std::size_t k = 0; k < 4 && i + k < key.size(); ++k) word |= std::uint32_t(std::uint8_t(key[i + k])) << (8 * k);
+        header.push_back(word);
+    }
+    return header;
+}
+
+}  // namespace
 
 bool limitsLoopIterations(vk::Context& context) {
     if (!context.isLlvmpipe()) return false;
@@ -18,6 +39,18 @@ bool limitsLoopIterations(vk::Context& context) {
     const std::string key = context.deviceName() + "|" + context.driverInfo();
     std::lock_guard<std::mutex> lock(mutex);
     if (auto it = probed.find(key); it != probed.end()) return it->second;
+    // A driver's answer does not change: kept in the cache directory, the
+    // probe (a pipeline and a dispatch, some 4 ms on lavapipe) runs once.
+    const std::vector<std::uint32_t> header = probeHeader(key);
+    vk::WordHash hash;
+    hash.add(header);
+    const std::string directory = context.cacheDirectory();
+    const std::filesystem::path path =
+        directory.empty() ? std::filesystem::path() : vk::keptPath(std::filesystem::path(directory) / "probes", hash.value(), ".probe");
+    if (!path.empty()) {
+        const std::vector<char> kept = vk::readKept(path, header);
+        if (kept.size() == 1 && (kept[0] == '0' || kept[0] == '1')) return probed[key] = kept[0] == '1';
+    }
 
     const std::uint32_t iterations = 2 * SNELL_DRIVER_LOOP_LIMIT;
     vk::Buffer result = context.createBuffer(sizeof(std::uint32_t), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::Context::Memory::HostCached);
@@ -32,7 +65,9 @@ bool limitsLoopIterations(vk::Context& context) {
         throw;
     }
     context.destroy(result);
-    return probed[key] = passes != iterations;
+    const bool limits = passes != iterations;
+    if (!path.empty()) vk::keep(path, header, std::string(limits ? "1" : "0"), 16);
+    return probed[key] = limits;
 }
 
 }  // namespace snell
