@@ -12,7 +12,11 @@
 // (docs/performance.md), and they count elements (2^27 texels on lavapipe), so
 // the documented limit of 4 000 000 spheres fits where 128 MiB of storage
 // buffer does not. Integers that ride in a vec4 are stored as the bits of a
-// uint and read through an RGBA32UI view: no float conversion, exact.
+// uint and read through an RGBA32UI view: no float conversion, exact. The
+// BVH can also be read as a storage buffer: Mesa 25's lavapipe calls a
+// function for every texel fetch, which in the walk's seven fetches a node
+// costs more than the loads (docs/performance.md, "The BVH as a storage
+// buffer"); its nodes stay under 128 MiB at 4 000 000 spheres (about 40 MiB).
 #ifndef SNELL_SHARED_LAYOUT_H
 #define SNELL_SHARED_LAYOUT_H
 
@@ -64,6 +68,10 @@ using uint = std::uint32_t;
 // driver's own traversal in place of the BVH walk: one geometry of AABBs,
 // primitive i the box of sphere i, in one instance.
 #define SNELL_BINDING_ACCELERATION 18
+// The BVH's nodes again, the same buffer read as a storage buffer where the
+// driver's loads of it beat its texel fetches (SNELL_SPEC_BVH_WORDS).
+#define SNELL_BINDING_BVH_WORDS 19
+#define SNELL_BINDING_LIMIT 20  // one past the largest binding
 
 // Specialization constants: compile only what a scene uses.
 #define SNELL_SPEC_USE_BVH 0
@@ -85,7 +93,8 @@ using uint = std::uint32_t;
 #define SNELL_SPEC_COUNT_LANES 16  // count the SIMD lanes busy in each loop pass (render --count-lanes)
 #define SNELL_SPEC_TRAPS 17        // some material traps light (render/Truncation.h, growthTraps)
 #define SNELL_SPEC_HELPS 18        // workgroups help with each other's shares of a tile (trace.comp, takePixel)
-#define SNELL_SPEC_COUNT 19
+#define SNELL_SPEC_BVH_WORDS 19    // the walk reads the BVH as a storage buffer (SNELL_BINDING_BVH_WORDS)
+#define SNELL_SPEC_COUNT 20
 
 // Slots of the counters buffer: rays by kind, then per-dispatch bookkeeping.
 #define SNELL_COUNTER_PRIMARY 0

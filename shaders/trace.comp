@@ -49,6 +49,7 @@ layout(constant_id = SNELL_SPEC_COUNT_RAYS) const bool COUNT_RAYS = false;
 // pass of the trace loop and of the BVH walk (lanes that left a loop, or
 // have nothing to trace, idle while the others go on).
 layout(constant_id = SNELL_SPEC_COUNT_LANES) const bool COUNT_LANES = false;
+layout(constant_id = SNELL_SPEC_BVH_WORDS) const bool BVH_WORDS = false;
 uint traceSlots = 0u, traceBusy = 0u, walkSlots = 0u, walkBusy = 0u;  // this invocation's share
 
 // Counts a pass of the subgroup's active lanes: subgroup-size slots, `busy` of them used.
@@ -91,6 +92,7 @@ layout(set = 0, binding = SNELL_BINDING_ELLIPSOIDS) uniform textureBuffer ellips
 layout(set = 0, binding = SNELL_BINDING_MATERIALS) uniform textureBuffer materialTexels;
 layout(set = 0, binding = SNELL_BINDING_LIGHTS) uniform textureBuffer lightTexels;
 layout(set = 0, binding = SNELL_BINDING_BVH) uniform utextureBuffer bvhTexels;
+layout(set = 0, binding = SNELL_BINDING_BVH_WORDS, std430) readonly buffer BvhBlock { uvec4 bvhWords[]; };
 #ifdef SNELL_RAY_QUERY
 layout(set = 0, binding = SNELL_BINDING_ACCELERATION) uniform accelerationStructureEXT sphereBoxes;
 #endif
@@ -167,8 +169,14 @@ rvec3 safeInverse(rvec3 d) {
     return 1.0 / mix(d, rvec3(tiny) * sign(d + rvec3(1e-38)), lessThan(abs(d), rvec3(tiny)));
 }
 
+// Word i of the BVH's nodes, from whichever of its two views the driver
+// reads faster (shared_layout.h).
+uvec4 bvhWord(int i) {
+    if (BVH_WORDS) return bvhWords[i];
+    return texelFetch(bvhTexels, i);
+}
 // Lane k of a node's vector is child k's (shared_layout.h: BvhNode).
-rvec4 nodeVector(int texel) { return rvec4(uintBitsToFloat(texelFetch(bvhTexels, texel))); }
+rvec4 nodeVector(int word) { return rvec4(uintBitsToFloat(bvhWord(word))); }
 
 // Sorts two (entry distance, child) pairs by distance.
 void orderPair(inout real enterA, inout uint childA, inout real enterB, inout uint childB) {
@@ -211,7 +219,7 @@ uint traverseBvh(rvec3 origin, real originLength, rvec3 dir, uint fromSphere, ui
             rvec4 y1 = (nodeVector(base + 3) - origin.y) * inverseDir.y;
             rvec4 z0 = (nodeVector(base + 4) - origin.z) * inverseDir.z;
             rvec4 z1 = (nodeVector(base + 5) - origin.z) * inverseDir.z;
-            uvec4 child = texelFetch(bvhTexels, base + 6);
+            uvec4 child = bvhWord(base + 6);
             // The slab test within [0, tHit] against boxes stored rounded outwards;
             // Ize, "Robust BVH Ray Traversal" (JCGT 2013): the exit distance is
             // widened so rounding never culls a box the ray touches.

@@ -612,6 +612,33 @@ TEST(GpuShaderObjects, KeptBinaryTracesThePipelinesImage) {
     }
 }
 
+// The BVH walk reads the nodes as texels or as a storage buffer, whichever
+// the driver reads faster (shared_layout.h): both trace the same image, bit
+// for bit, on every driver.
+TEST(GpuBvhWords, StorageReadsTraceTheTexelsImage) {
+    struct Case {
+        const char* file;
+        snell::gpu::Precision precision;
+    };
+    for (const Case& c : {Case{SNELL_SOURCE_DIR "/scenes/grid.scn", snell::gpu::Precision::Fp32},
+                          Case{SNELL_SOURCE_DIR "/scenes/grid.scn", snell::gpu::Precision::Fp64},
+                          Case{SNELL_SHARED_DIR "/course-scenes/becker-SphereFlake2.scn", snell::gpu::Precision::Fp32}}) {
+        const bool wide = c.precision == snell::gpu::Precision::Fp64;
+        SCOPED_TRACE(std::string(c.file) + (wide ? " fp64" : " fp32"));
+        if (wide && !context().float64Supported()) continue;
+        const snell::Scene scene = snell::parseSceneFile(c.file);
+        const snell::RenderRequest request = wholeImage(scene, 64);
+        snell::ComputeRenderer renderer(context(), scene, request.camera, c.precision, snell::gpu::BvhMode::On,
+                                        snell::gpu::Traversal::Walk);
+        renderer.readBvhWords(false);
+        const snell::GpuRenderResult texels = renderer.render(request, false);
+        renderer.readBvhWords(true);
+        const snell::GpuRenderResult words = renderer.render(request, false);
+        ASSERT_EQ(words.image.rgb.size(), texels.image.rgb.size());
+        EXPECT_EQ(pixelsThatDiffer(texels.image, words.image), 0u) << "pixels that differ between the BVH's two views";
+    }
+}
+
 TEST(GpuPlan, TracesTheImageOfLavapipesPlan) {
     for (const char* file : {SNELL_SOURCE_DIR "/scenes/grid.scn", SNELL_SOURCE_DIR "/scenes/glass.scn"}) {
         SCOPED_TRACE(file);

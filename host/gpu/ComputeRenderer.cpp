@@ -96,20 +96,26 @@ ComputeRenderer::ComputeRenderer(vk::Context& context, const Scene& scene, const
     const bool rayQuery = precision == gpu::Precision::Fp32 && context.rayQueriesEnabled() &&
                           (traversal == gpu::Traversal::RayQuery ||
                            (traversal == gpu::Traversal::Auto && !context.isCpuDevice()));
+    // Mesa 25's lavapipe calls a function for each texel fetch; its loads of
+    // a storage buffer are faster in the BVH walk, and slower on Mesa 22.3
+    // (docs/performance.md, "The BVH as a storage buffer").
+    bvhWords_ = context.isLlvmpipe() && context.mesaMajor() >= 25;
     const auto start = Clock::now();
     layout_ = gpu::buildGpuScene(scene, camera, precision, bvh, rayQuery);
     loopBudget_ = limitsLoopIterations(context) ? SNELL_LOOP_BUDGET_LIMITED : 0u;
     // Each scene array becomes a texel buffer (shared_layout.h): its structs
     // are runs of RGBA32 texels (R32 for a uint array).
     const VkDeviceSize maxTexels = context.properties().limits.maxTexelBufferElements;
-    auto upload = [&](std::uint32_t binding, const auto& v, VkFormat format, const char* what) {
+    auto upload = [&](std::uint32_t binding, const auto& v, VkFormat format, const char* what,
+                      VkBufferUsageFlags alsoAs = 0) {
         const VkDeviceSize bytes = v.size() * sizeof(v[0]);
         const VkDeviceSize texelBytes = format == VK_FORMAT_R32_UINT ? 4 : 16;
         if (bytes / texelBytes > maxTexels)
             throw vk::VulkanError(std::string("the scene's ") + what + " need " + std::to_string(bytes / texelBytes) +
                                   " texels, more than this device's texel-buffer limit of " +
                                   std::to_string(maxTexels));
-        sceneBuffers_[binding] = context_.createBufferWithData(v.data(), bytes, VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT);
+        sceneBuffers_[binding] =
+            context_.createBufferWithData(v.data(), bytes, VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT | alsoAs);
         VkBufferViewCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_VIEW_CREATE_INFO};
         info.buffer = sceneBuffers_[binding].buffer;
         info.format = format;
@@ -123,7 +129,9 @@ ComputeRenderer::ComputeRenderer(vk::Context& context, const Scene& scene, const
         upload(SNELL_BINDING_ELLIPSOIDS, layout_.ellipsoids, rgba, "ellipsoids");
         upload(SNELL_BINDING_MATERIALS, layout_.materials, rgba, "materials");
         upload(SNELL_BINDING_LIGHTS, layout_.lights, rgba, "lights");
-        upload(SNELL_BINDING_BVH, layout_.nodes, VK_FORMAT_R32G32B32A32_UINT, "BVH nodes");
+        // Read as texels, or as a storage buffer (SNELL_BINDING_BVH_WORDS).
+        upload(SNELL_BINDING_BVH, layout_.nodes, VK_FORMAT_R32G32B32A32_UINT, "BVH nodes",
+               VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
         if (!layout_.sphereBoxes.empty())
             sphereBoxes_ = std::make_unique<vk::BoxAccelerationStructure>(
                 context_, layout_.sphereBoxes.data(), static_cast<std::uint32_t>(layout_.sphereBoxes.size()));
@@ -220,6 +228,7 @@ ComputeRenderer::Specialisation ComputeRenderer::specialise(const RenderRequest&
     const bool hasReflection = scene_.anyReflection() && request.trace.reflection;
     Specialisation values{};
     values[SNELL_SPEC_USE_BVH] = layout_.usesBvh();
+    values[SNELL_SPEC_BVH_WORDS] = layout_.usesBvh() && bvhWords_;
     const bool unrolled = !layout_.usesBvh() && layout_.spheres.size() <= SNELL_MAX_UNROLLED_SPHERES;
     values[SNELL_SPEC_SPHERE_COUNT] = unrolled ? static_cast<std::uint32_t>(layout_.spheres.size()) : 0u;
     values[SNELL_SPEC_SPHERES_IN_BLOCK] = spheresInBlock();
@@ -308,6 +317,7 @@ void ComputeRenderer::createPipeline(const Specialisation& values, Pipeline& p) 
     p.bindings.clear();
     for (std::uint32_t i = 0; i < (wide ? SNELL_BINDING_COUNT : SNELL_BINDING_COUNT_FP32); ++i) p.bindings.push_back(i);
     if (sphereBoxes_) p.bindings.push_back(SNELL_BINDING_ACCELERATION);
+    p.bindings.push_back(SNELL_BINDING_BVH_WORDS);
     std::vector<VkDescriptorSetLayoutBinding> bindings(p.bindings.size());
     for (std::size_t k = 0; k < bindings.size(); ++k) {
         bindings[k].binding = p.bindings[k];
@@ -634,8 +644,9 @@ void ComputeRenderer::ensureBuffers(Pipeline& p, const RenderRequest& request, c
         p.output = context_.createBuffer(p.tilePixels * sizeof(gpu::OutputPixel), kStorage, vk::Context::Memory::HostCached);
     }
 
-    std::array<VkDescriptorBufferInfo, SNELL_BINDING_ACCELERATION + 1> bufferInfo{};
-    std::array<const vk::Buffer*, SNELL_BINDING_ACCELERATION + 1> buffers{};
+    std::array<VkDescriptorBufferInfo, SNELL_BINDING_LIMIT> bufferInfo{};
+    std::array<const vk::Buffer*, SNELL_BINDING_LIMIT> buffers{};
+    buffers[SNELL_BINDING_BVH_WORDS] = &sceneBuffers_[SNELL_BINDING_BVH];
     buffers[SNELL_BINDING_OUTPUT] = &p.output;
     buffers[SNELL_BINDING_FRAME] = &p.frame;
     buffers[SNELL_BINDING_COUNTERS] = &p.counters;

@@ -98,6 +98,10 @@ public:
     // (vulkan/SpecialisedModule.h). The image is the same either way.
     void foldSpecialisation(bool fold) { foldSpecialisation_ = fold; }
     bool kernelFolded() const;  // the last render's kernel had its specialisation folded in
+    // Testing: whether the BVH walk reads the nodes as a storage buffer or as
+    // texels (by default as the driver reads faster). The image is the same.
+    void readBvhWords(bool words) { bvhWords_ = words; }
+    bool readsBvhWords() const { return bvhWords_; }
     // With false, the kernel is a pipeline even where the device has shader
     // objects (vulkan/ShaderObject.h). The image is the same either way.
     void useShaderObjects(bool use) { useShaderObjects_ = use; }
@@ -144,6 +148,7 @@ private:
     bool planAsGpu_ = false;
     bool foldSpecialisation_ = true;
     bool useShaderObjects_ = true;
+    bool bvhWords_ = false;
     std::uint32_t loopBudget_ = 0;  // where the driver ends long loops (gpu/DriverProbe.h), else 0
     bool countLanes_ = false;
     double uploadMs_ = 0.0;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -483,6 +484,12 @@ void Context::openPipelineCache(const std::string& path) {
 }
 
 Context::~Context() { release(); }
+
+int Context::mesaMajor() const {
+    const std::size_t at = driverInfo_.find("Mesa ");
+    if (at == std::string::npos) return 0;
+    return std::atoi(driverInfo_.c_str() + at + 5);
+}
 
 std::string Context::cacheDirectory() const {
     return pipelineCachePath_.empty() ? std::string() : std::filesystem::path(pipelineCachePath_).parent_path().string();

@@ -135,6 +135,8 @@ public:
     // Mesa's llvmpipe (lavapipe): its shaders end all loops after 65535
     // iterations per SIMD row and dispatch, which the renderer works around.
     bool isLlvmpipe() const { return driverId_ == VK_DRIVER_ID_MESA_LLVMPIPE; }
+    // The major version of a Mesa driver (from its driver info, "Mesa 25.0.7"); 0 for others.
+    int mesaMajor() const;
     // Validation-layer errors and warnings reported so far.
     std::uint32_t validationMessages() const { return validationMessages_; }
     const std::vector<DeviceReport>& deviceReports() const { return reports_; }
