@@ -16,7 +16,8 @@
 // BVH can also be read as a storage buffer: Mesa 25's lavapipe calls a
 // function for every texel fetch, which in the walk's seven fetches a node
 // costs more than the loads (docs/performance.md, "The BVH as a storage
-// buffer"); its nodes stay under 128 MiB at 4 000 000 spheres (about 40 MiB).
+// buffer"). Storage buffers are limited in bytes (128 MiB on lavapipe), and
+// 4 000 000 spheres make 222 MB of nodes: such a BVH is read as texels.
 #ifndef SNELL_SHARED_LAYOUT_H
 #define SNELL_SHARED_LAYOUT_H
 

@@ -197,7 +197,7 @@ void orderPair(inout real enterA, inout uint childA, inout real enterB, inout ui
 // stack or its parent without a fetch of its own: its code says which
 // spheres it holds.
 // anyHit: stop at the first hit before tMax (SPEC §4.3 visibility).
-uint bvhStack[BVH_DEPTH];
+uint bvhStack[BVH_DEPTH + 1u];  // one more: the unconditional store past the last entry
 uint traverseBvh(rvec3 origin, real originLength, rvec3 dir, uint fromSphere, uint start, bool anyHit,
                  inout real tHit) {
     rvec3 inverseDir = safeInverse(dir);
@@ -237,9 +237,15 @@ uint traverseBvh(rvec3 origin, real originLength, rvec3 dir, uint fromSphere, ui
             orderPair(k0, c0, k2, c2);
             orderPair(k1, c1, k3, c3);
             orderPair(k1, c1, k2, c2);
-            if (k3 < never) bvhStack[depth++] = c3;
-            if (k2 < never) bvhStack[depth++] = c2;
-            if (k1 < never) bvhStack[depth++] = c1;
+            // Each store is made whether or not its child was entered (one not
+            // entered is overwritten next): stores under per-lane conditions
+            // become a branch per lane on lavapipe, each one hard to predict.
+            bvhStack[depth] = c3;
+            depth += k3 < never ? 1u : 0u;
+            bvhStack[depth] = c2;
+            depth += k2 < never ? 1u : 0u;
+            bvhStack[depth] = c1;
+            depth += k1 < never ? 1u : 0u;
             if (k0 < never) entry = c0;
             else if (depth > 0u) entry = bvhStack[--depth];
             else walking = false;

@@ -99,9 +99,9 @@ ComputeRenderer::ComputeRenderer(vk::Context& context, const Scene& scene, const
     // Mesa 25's lavapipe calls a function for each texel fetch; its loads of
     // a storage buffer are faster in the BVH walk, and slower on Mesa 22.3
     // (docs/performance.md, "The BVH as a storage buffer").
-    bvhWords_ = context.isLlvmpipe() && context.mesaMajor() >= 25;
     const auto start = Clock::now();
     layout_ = gpu::buildGpuScene(scene, camera, precision, bvh, rayQuery);
+    bvhWords_ = context.isLlvmpipe() && context.mesaMajor() >= 25 && bvhFitsWords();
     loopBudget_ = limitsLoopIterations(context) ? SNELL_LOOP_BUDGET_LIMITED : 0u;
     // Each scene array becomes a texel buffer (shared_layout.h): its structs
     // are runs of RGBA32 texels (R32 for a uint array).
@@ -155,6 +155,10 @@ ComputeRenderer::ComputeRenderer(vk::Context& context, const Scene& scene, const
         throw;
     }
     uploadMs_ = msSince(start);
+}
+
+bool ComputeRenderer::bvhFitsWords() const {
+    return layout_.nodes.size() * sizeof(layout_.nodes[0]) <= context_.properties().limits.maxStorageBufferRange;
 }
 
 const char* ComputeRenderer::traversal() const {
@@ -646,7 +650,7 @@ void ComputeRenderer::ensureBuffers(Pipeline& p, const RenderRequest& request, c
 
     std::array<VkDescriptorBufferInfo, SNELL_BINDING_LIMIT> bufferInfo{};
     std::array<const vk::Buffer*, SNELL_BINDING_LIMIT> buffers{};
-    buffers[SNELL_BINDING_BVH_WORDS] = &sceneBuffers_[SNELL_BINDING_BVH];
+
     buffers[SNELL_BINDING_OUTPUT] = &p.output;
     buffers[SNELL_BINDING_FRAME] = &p.frame;
     buffers[SNELL_BINDING_COUNTERS] = &p.counters;
@@ -671,6 +675,14 @@ void ComputeRenderer::ensureBuffers(Pipeline& p, const RenderRequest& request, c
             accelerationInfo.accelerationStructureCount = 1;
             accelerationInfo.pAccelerationStructures = &sphereBoxes_->top();
             writes[k].pNext = &accelerationInfo;
+        } else if (i == SNELL_BINDING_BVH_WORDS) {
+            // The texels' buffer again. A BVH larger than a storage buffer may
+            // be is never read through this view (bvhFitsWords), but the
+            // descriptor must still be valid.
+            const vk::Buffer& nodes = sceneBuffers_[SNELL_BINDING_BVH];
+            bufferInfo[i] = {nodes.buffer, 0,
+                             std::min<VkDeviceSize>(nodes.size, context_.properties().limits.maxStorageBufferRange)};
+            writes[k].pBufferInfo = &bufferInfo[i];
         } else {
             if (!buffers[i]) buffers[i] = &sceneBuffers_[i];
             bufferInfo[i] = {buffers[i]->buffer, 0, VK_WHOLE_SIZE};

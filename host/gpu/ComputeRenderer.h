@@ -99,8 +99,9 @@ public:
     void foldSpecialisation(bool fold) { foldSpecialisation_ = fold; }
     bool kernelFolded() const;  // the last render's kernel had its specialisation folded in
     // Testing: whether the BVH walk reads the nodes as a storage buffer or as
-    // texels (by default as the driver reads faster). The image is the same.
-    void readBvhWords(bool words) { bvhWords_ = words; }
+    // texels (by default as the driver reads faster, and texels where the
+    // nodes exceed the device's storage-buffer range). The image is the same.
+    void readBvhWords(bool words) { bvhWords_ = words && bvhFitsWords(); }
     bool readsBvhWords() const { return bvhWords_; }
     // With false, the kernel is a pipeline even where the device has shader
     // objects (vulkan/ShaderObject.h). The image is the same either way.
@@ -137,6 +138,7 @@ private:
                 const std::function<void(VkCommandBuffer)>& record);
     void destroyBuffers();
     bool spheresInBlock() const;  // every sphere in the uniform block (shared_layout.h)
+    bool bvhFitsWords() const;    // the BVH's nodes fit in one storage-buffer descriptor
 
     vk::Context& context_;
     const Scene& scene_;
