@@ -96,11 +96,11 @@ ComputeRenderer::ComputeRenderer(vk::Context& context, const Scene& scene, const
     const bool rayQuery = precision == gpu::Precision::Fp32 && context.rayQueriesEnabled() &&
                           (traversal == gpu::Traversal::RayQuery ||
                            (traversal == gpu::Traversal::Auto && !context.isCpuDevice()));
+    const auto start = Clock::now();
+    layout_ = gpu::buildGpuScene(scene, camera, precision, bvh, rayQuery);
     // Mesa 25's lavapipe calls a function for each texel fetch; its loads of
     // a storage buffer are faster in the BVH walk, and slower on Mesa 22.3
     // (docs/performance.md, "The BVH as a storage buffer").
-    const auto start = Clock::now();
-    layout_ = gpu::buildGpuScene(scene, camera, precision, bvh, rayQuery);
     bvhWords_ = context.isLlvmpipe() && context.mesaMajor() >= 25 && bvhFitsWords();
     loopBudget_ = limitsLoopIterations(context) ? SNELL_LOOP_BUDGET_LIMITED : 0u;
     // Each scene array becomes a texel buffer (shared_layout.h): its structs
@@ -273,7 +273,7 @@ ComputeRenderer::Specialisation ComputeRenderer::specialise(const RenderRequest&
 // The kernel alone, for p's module, layout and specialisation: a shader
 // object from its kept binary where the device has them and the run keeps a
 // cache, else a pipeline.
-void ComputeRenderer::createComputePipeline(Pipeline& p, std::span<const std::uint32_t> code) {
+void ComputeRenderer::createKernel(Pipeline& p, std::span<const std::uint32_t> code) {
     std::array<VkSpecializationMapEntry, SNELL_SPEC_COUNT> entries{};
     for (std::uint32_t i = 0; i < entries.size(); ++i)
         entries[i] = {i, i * static_cast<std::uint32_t>(sizeof(std::uint32_t)), sizeof(std::uint32_t)};
@@ -352,7 +352,7 @@ void ComputeRenderer::createPipeline(const Specialisation& values, Pipeline& p) 
     p.folded = !folded.empty();
     p.rayEntries = values[SNELL_SPEC_RAY_STACK] + values[SNELL_SPEC_FRONTIER];
     p.maxMedia = values[SNELL_SPEC_MAX_MEDIA];
-    createComputePipeline(p, p.folded ? Words(folded) : compiled);
+    createKernel(p, p.folded ? Words(folded) : compiled);
 
     std::vector<VkDescriptorPoolSize> sizes;
     for (std::uint32_t binding : p.bindings) {

@@ -117,7 +117,7 @@ private:
     using Specialisation = std::array<std::uint32_t, SNELL_SPEC_COUNT>;
     Specialisation specialise(const RenderRequest& request, bool countRays) const;
     void createPipeline(const Specialisation& values, Pipeline& pipeline);
-    void createComputePipeline(Pipeline& pipeline, std::span<const std::uint32_t> code);
+    void createKernel(Pipeline& pipeline, std::span<const std::uint32_t> code);
     void bindKernel(VkCommandBuffer cmd, const Pipeline& pipeline) const;
     void destroyPipeline(Pipeline& pipeline);
     // The phases of render(), in order.
