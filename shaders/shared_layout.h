@@ -95,7 +95,11 @@ using uint = std::uint32_t;
 #define SNELL_SPEC_TRAPS 17        // some material traps light (render/Truncation.h, growthTraps)
 #define SNELL_SPEC_HELPS 18        // workgroups help with each other's shares of a tile (trace.comp, takePixel)
 #define SNELL_SPEC_BVH_WORDS 19    // the walk reads the BVH as a storage buffer (SNELL_BINDING_BVH_WORDS)
-#define SNELL_SPEC_COUNT 20
+#define SNELL_SPEC_STACK_IN_REGISTERS 20  // the walk's stack in registers (trace.comp, pushEntry)
+#define SNELL_SPEC_COUNT 21
+// The deepest walk stack kept in registers (entries); a deeper one is an array
+// at a per-lane index.
+#define SNELL_REGISTER_STACK_LIMIT 32
 
 // Slots of the counters buffer: rays by kind, then per-dispatch bookkeeping.
 #define SNELL_COUNTER_PRIMARY 0

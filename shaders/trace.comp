@@ -50,6 +50,7 @@ layout(constant_id = SNELL_SPEC_COUNT_RAYS) const bool COUNT_RAYS = false;
 // have nothing to trace, idle while the others go on).
 layout(constant_id = SNELL_SPEC_COUNT_LANES) const bool COUNT_LANES = false;
 layout(constant_id = SNELL_SPEC_BVH_WORDS) const bool BVH_WORDS = false;
+layout(constant_id = SNELL_SPEC_STACK_IN_REGISTERS) const bool STACK_IN_REGISTERS = false;
 uint traceSlots = 0u, traceBusy = 0u, walkSlots = 0u, walkBusy = 0u;  // this invocation's share
 
 // Counts a pass of the subgroup's active lanes: subgroup-size slots, `busy` of them used.
@@ -189,6 +190,35 @@ void orderPair(inout real enterA, inout uint childA, inout real enterB, inout ui
     childB = swap ? c : childB;
 }
 
+// The walk's stack. Up to SNELL_REGISTER_STACK_LIMIT entries it lives in
+// registers: its top is entry 0, a push moves every entry down one and a pop
+// up one, each index a constant (the loops unrolled), so a push under a
+// per-lane condition is a blend. At a per-lane index (the top at depth − 1,
+// as in deeper trees) a store is a write to memory lane by lane, each behind
+// a branch on that lane's mask, which lavapipe cannot predict where lanes
+// differ. (The host sets STACK_IN_REGISTERS.)
+uint bvhStack[BVH_DEPTH + 1u];  // one more: the store past the last entry
+// Pushes child where the ray entered its box.
+void pushEntry(uint child, bool entered, inout uint depth) {
+    if (STACK_IN_REGISTERS) {
+        [[unroll]] for (int i = 1; i < int(BVH_DEPTH); ++i) {
+            int k = int(BVH_DEPTH) - i;
+            bvhStack[k] = entered ? bvhStack[k - 1] : bvhStack[k];
+        }
+        bvhStack[0] = entered ? child : bvhStack[0];
+    } else {
+        bvhStack[depth] = child;  // stored either way: one not entered is overwritten next
+    }
+    depth += entered ? 1u : 0u;
+}
+uint popEntry(inout uint depth) {
+    --depth;
+    if (!STACK_IN_REGISTERS) return bvhStack[depth];
+    uint top = bvhStack[0];
+    [[unroll]] for (int k = 1; k < int(BVH_DEPTH); ++k) bvhStack[k - 1] = bvhStack[k];
+    return top;
+}
+
 // The BVH walk shared by the closest hit and the visibility test. A node's
 // four children's boxes are tested at once (a slab test a vector lane each);
 // those the ray enters are taken nearest first, the others waiting on
@@ -197,7 +227,6 @@ void orderPair(inout real enterA, inout uint childA, inout real enterB, inout ui
 // stack or its parent without a fetch of its own: its code says which
 // spheres it holds.
 // anyHit: stop at the first hit before tMax (SPEC §4.3 visibility).
-uint bvhStack[BVH_DEPTH + 1u];  // one more: the unconditional store past the last entry
 uint traverseBvh(rvec3 origin, real originLength, rvec3 dir, uint fromSphere, uint start, bool anyHit,
                  inout real tHit) {
     rvec3 inverseDir = safeInverse(dir);
@@ -237,17 +266,11 @@ uint traverseBvh(rvec3 origin, real originLength, rvec3 dir, uint fromSphere, ui
             orderPair(k0, c0, k2, c2);
             orderPair(k1, c1, k3, c3);
             orderPair(k1, c1, k2, c2);
-            // Each store is made whether or not its child was entered (one not
-            // entered is overwritten next): stores under per-lane conditions
-            // become a branch per lane on lavapipe, each one hard to predict.
-            bvhStack[depth] = c3;
-            depth += k3 < never ? 1u : 0u;
-            bvhStack[depth] = c2;
-            depth += k2 < never ? 1u : 0u;
-            bvhStack[depth] = c1;
-            depth += k1 < never ? 1u : 0u;
+            pushEntry(c3, k3 < never, depth);
+            pushEntry(c2, k2 < never, depth);
+            pushEntry(c1, k1 < never, depth);
             if (k0 < never) entry = c0;
-            else if (depth > 0u) entry = bvhStack[--depth];
+            else if (depth > 0u) entry = popEntry(depth);
             else walking = false;
         }
         if (walking && (entry & SNELL_BVH_LEAF) != 0u) {
@@ -263,7 +286,7 @@ uint traverseBvh(rvec3 origin, real originLength, rvec3 dir, uint fromSphere, ui
                 }
             }
             if ((anyHit && hit != NONE) || depth == 0u) walking = false;
-            else entry = bvhStack[--depth];
+            else entry = popEntry(depth);
         }
     }
     return hit;

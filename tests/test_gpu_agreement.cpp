@@ -8,6 +8,8 @@
 #include <algorithm>
 #include <chrono>
 #include <filesystem>
+#include <functional>
+#include <initializer_list>
 #include <map>
 #include <memory>
 #include <string>
@@ -612,17 +614,17 @@ TEST(GpuShaderObjects, KeptBinaryTracesThePipelinesImage) {
     }
 }
 
-// The BVH walk reads the nodes as texels or as a storage buffer, whichever
-// the driver reads faster (shared_layout.h): both trace the same image, bit
-// for bit, on every driver.
-TEST(GpuBvhWords, StorageReadsTraceTheTexelsImage) {
-    struct Case {
-        const char* file;
-        snell::gpu::Precision precision;
-    };
-    for (const Case& c : {Case{SNELL_SOURCE_DIR "/scenes/grid.scn", snell::gpu::Precision::Fp32},
-                          Case{SNELL_SOURCE_DIR "/scenes/grid.scn", snell::gpu::Precision::Fp64},
-                          Case{SNELL_SHARED_DIR "/course-scenes/becker-SphereFlake2.scn", snell::gpu::Precision::Fp32}}) {
+// A BVH scene, a precision: a case for the walk's variants below.
+struct WalkCase {
+    const char* file;
+    snell::gpu::Precision precision;
+};
+
+// Renders each case with `choose(renderer, false)` and again with
+// `choose(renderer, true)` and requires the same image, bit for bit.
+void requireTheSameWalk(std::initializer_list<WalkCase> cases,
+                        const std::function<void(snell::ComputeRenderer&, bool)>& choose, const char* what) {
+    for (const WalkCase& c : cases) {
         const bool wide = c.precision == snell::gpu::Precision::Fp64;
         SCOPED_TRACE(std::string(c.file) + (wide ? " fp64" : " fp32"));
         if (wide && !context().float64Supported()) continue;
@@ -630,13 +632,39 @@ TEST(GpuBvhWords, StorageReadsTraceTheTexelsImage) {
         const snell::RenderRequest request = wholeImage(scene, 64);
         snell::ComputeRenderer renderer(context(), scene, request.camera, c.precision, snell::gpu::BvhMode::On,
                                         snell::gpu::Traversal::Walk);
-        renderer.readBvhWords(false);
-        const snell::GpuRenderResult texels = renderer.render(request, false);
-        renderer.readBvhWords(true);
-        const snell::GpuRenderResult words = renderer.render(request, false);
-        ASSERT_EQ(words.image.rgb.size(), texels.image.rgb.size());
-        EXPECT_EQ(pixelsThatDiffer(texels.image, words.image), 0u) << "pixels that differ between the BVH's two views";
+        choose(renderer, false);
+        const snell::GpuRenderResult without = renderer.render(request, false);
+        choose(renderer, true);
+        const snell::GpuRenderResult with = renderer.render(request, false);
+        ASSERT_EQ(with.image.rgb.size(), without.image.rgb.size());
+        EXPECT_EQ(pixelsThatDiffer(without.image, with.image), 0u) << "pixels that differ between " << what;
     }
+}
+
+// The BVH walk reads the nodes as texels or as a storage buffer, whichever
+// the driver reads faster (shared_layout.h): both trace the same image, bit
+// for bit, on every driver.
+TEST(GpuBvhWords, StorageReadsTraceTheTexelsImage) {
+    requireTheSameWalk({{SNELL_SOURCE_DIR "/scenes/grid.scn", snell::gpu::Precision::Fp32},
+                        {SNELL_SOURCE_DIR "/scenes/grid.scn", snell::gpu::Precision::Fp64},
+                        {SNELL_SHARED_DIR "/course-scenes/becker-SphereFlake2.scn", snell::gpu::Precision::Fp32}},
+                       [](snell::ComputeRenderer& renderer, bool words) { renderer.readBvhWords(words); },
+                       "the BVH's two views");
+}
+
+// The walk's stack lives in registers where it is short enough, else in an
+// array (trace.comp, pushEntry): both trace the same image, bit for bit.
+// SphereFlake4's stack (30 entries) is near the limit of 32.
+TEST(GpuBvhStack, RegistersTraceTheArraysImage) {
+    requireTheSameWalk({{SNELL_SOURCE_DIR "/scenes/grid.scn", snell::gpu::Precision::Fp32},
+                        {SNELL_SOURCE_DIR "/scenes/grid.scn", snell::gpu::Precision::Fp64},
+                        {SNELL_SHARED_DIR "/course-scenes/becker-SphereFlake2.scn", snell::gpu::Precision::Fp32},
+                        {SNELL_SHARED_DIR "/course-scenes/becker-SphereFlake4.scn", snell::gpu::Precision::Fp32}},
+                       [](snell::ComputeRenderer& renderer, bool registers) {
+                           renderer.keepStackInRegisters(registers);
+                           EXPECT_EQ(renderer.stackInRegisters(), registers);
+                       },
+                       "the two stacks");
 }
 
 TEST(GpuPlan, TracesTheImageOfLavapipesPlan) {

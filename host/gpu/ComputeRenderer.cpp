@@ -161,6 +161,10 @@ bool ComputeRenderer::bvhFitsWords() const {
     return layout_.nodes.size() * sizeof(layout_.nodes[0]) <= context_.properties().limits.maxStorageBufferRange;
 }
 
+bool ComputeRenderer::stackInRegisters() const {
+    return stackInRegisters_ && layout_.usesBvh() && layout_.bvhStackSize() <= SNELL_REGISTER_STACK_LIMIT;
+}
+
 const char* ComputeRenderer::traversal() const {
     return sphereBoxes_ ? "ray-query" : layout_.usesBvh() ? "bvh" : "loop";
 }
@@ -240,6 +244,7 @@ ComputeRenderer::Specialisation ComputeRenderer::specialise(const RenderRequest&
         for (std::size_t i = 0; i < layout_.spheres.size(); ++i)
             if (layout_.spheres[i].anchorRadius.w < 0.0f) values[SNELL_SPEC_ELLIPSOID_MASK] |= 1u << i;
     values[SNELL_SPEC_BVH_DEPTH] = static_cast<std::uint32_t>(layout_.bvhStackSize());
+    values[SNELL_SPEC_STACK_IN_REGISTERS] = stackInRegisters();
     values[SNELL_SPEC_HAS_ELLIPSOIDS] = !layout_.ellipsoids.empty();
     values[SNELL_SPEC_HAS_REFRACTION] = hasRefraction;
     values[SNELL_SPEC_HAS_REFLECTION] = hasReflection;
