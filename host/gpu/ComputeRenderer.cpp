@@ -102,6 +102,10 @@ ComputeRenderer::ComputeRenderer(vk::Context& context, const Scene& scene, const
     // a storage buffer are faster in the BVH walk, and slower on Mesa 22.3
     // (docs/performance.md, "The BVH as a storage buffer").
     bvhWords_ = context.isLlvmpipe() && context.mesaMajor() >= 25 && bvhFitsWords();
+    // A CPU device runs a SIMD row's stores at per-lane indices lane by lane;
+    // a GPU keeps such a stack in its local memory (unmeasured there: left
+    // as it was). docs/performance.md, "The walk's stack in registers".
+    stackInRegisters_ = context.isCpuDevice();
     loopBudget_ = limitsLoopIterations(context) ? SNELL_LOOP_BUDGET_LIMITED : 0u;
     // Each scene array becomes a texel buffer (shared_layout.h): its structs
     // are runs of RGBA32 texels (R32 for a uint array).

@@ -103,9 +103,9 @@ public:
     // nodes exceed the device's storage-buffer range). The image is the same.
     void readBvhWords(bool words) { bvhWords_ = words && bvhFitsWords(); }
     bool readsBvhWords() const { return bvhWords_; }
-    // Testing: with false, the walk's stack is an array at a per-lane index
-    // even where it would fit in registers (SNELL_REGISTER_STACK_LIMIT). The
-    // image is the same either way.
+    // Testing: whether the walk's stack may live in registers where it fits
+    // (SNELL_REGISTER_STACK_LIMIT; by default on CPU devices), else an array at
+    // a per-lane index. The image is the same either way.
     void keepStackInRegisters(bool registers) { stackInRegisters_ = registers; }
     bool stackInRegisters() const;  // the walk's stack is in registers (this scene, this setting)
     // With false, the kernel is a pipeline even where the device has shader
@@ -156,7 +156,7 @@ private:
     bool foldSpecialisation_ = true;
     bool useShaderObjects_ = true;
     bool bvhWords_ = false;
-    bool stackInRegisters_ = true;
+    bool stackInRegisters_ = false;
     std::uint32_t loopBudget_ = 0;  // where the driver ends long loops (gpu/DriverProbe.h), else 0
     bool countLanes_ = false;
     double uploadMs_ = 0.0;
