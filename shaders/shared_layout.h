@@ -96,7 +96,8 @@ using uint = std::uint32_t;
 #define SNELL_SPEC_HELPS 18        // workgroups help with each other's shares of a tile (trace.comp, takePixel)
 #define SNELL_SPEC_BVH_WORDS 19    // the walk reads the BVH as a storage buffer (SNELL_BINDING_BVH_WORDS)
 #define SNELL_SPEC_STACK_IN_REGISTERS 20  // the walk's stack in registers (trace.comp, pushEntry)
-#define SNELL_SPEC_COUNT 21
+#define SNELL_SPEC_SHARE_SHADOW_RAYS 21  // a subgroup's shadow rays walked by all its lanes (trace.comp, shadeLightsShared)
+#define SNELL_SPEC_COUNT 22
 // The deepest walk stack kept in registers (entries); a deeper one is an array
 // at a per-lane index.
 #define SNELL_REGISTER_STACK_LIMIT 32

@@ -51,6 +51,7 @@ layout(constant_id = SNELL_SPEC_COUNT_RAYS) const bool COUNT_RAYS = false;
 layout(constant_id = SNELL_SPEC_COUNT_LANES) const bool COUNT_LANES = false;
 layout(constant_id = SNELL_SPEC_BVH_WORDS) const bool BVH_WORDS = false;
 layout(constant_id = SNELL_SPEC_STACK_IN_REGISTERS) const bool STACK_IN_REGISTERS = false;
+layout(constant_id = SNELL_SPEC_SHARE_SHADOW_RAYS) const bool SHARE_SHADOW_RAYS = false;
 uint traceSlots = 0u, traceBusy = 0u, walkSlots = 0u, walkBusy = 0u;  // this invocation's share
 
 // Counts a pass of the subgroup's active lanes: subgroup-size slots, `busy` of them used.
@@ -227,67 +228,76 @@ uint popEntry(inout uint depth) {
 // stack or its parent without a fetch of its own: its code says which
 // spheres it holds.
 // anyHit: stop at the first hit before tMax (SPEC §4.3 visibility).
+//
+// One pass of the walk. entry: in hand, a node's index or SNELL_BVH_LEAF | a
+// leaf's code; depth: the entries on the stack; walking: false once done.
+void walkPass(inout uint entry, inout uint depth, inout bool walking, inout real tHit, inout uint hit,
+              rvec3 origin, real originLength, rvec3 dir, rvec3 inverseDir, uint fromSphere, uint start,
+              bool anyHit) {
+    // A pass takes an inner node, then the leaf in hand if there is one
+    // (the node's nearest child, or the next waiting entry): one pass for
+    // both, so lanes at leaves and lanes at nodes go on together.
+    if ((entry & SNELL_BVH_LEAF) == 0u) {
+        int base = int(entry) * SNELL_BVH_NODE_TEXELS;
+        rvec4 x0 = (nodeVector(base) - origin.x) * inverseDir.x;
+        rvec4 x1 = (nodeVector(base + 1) - origin.x) * inverseDir.x;
+        rvec4 y0 = (nodeVector(base + 2) - origin.y) * inverseDir.y;
+        rvec4 y1 = (nodeVector(base + 3) - origin.y) * inverseDir.y;
+        rvec4 z0 = (nodeVector(base + 4) - origin.z) * inverseDir.z;
+        rvec4 z1 = (nodeVector(base + 5) - origin.z) * inverseDir.z;
+        uvec4 child = bvhWord(base + 6);
+        // The slab test within [0, tHit] against boxes stored rounded outwards;
+        // Ize, "Robust BVH Ray Traversal" (JCGT 2013): the exit distance is
+        // widened so rounding never culls a box the ray touches.
+        rvec4 enter = max(max(min(x0, x1), min(y0, y1)), max(min(z0, z1), rvec4(0.0)));
+        rvec4 leave = min(min(max(x0, x1), max(y0, y1)), min(max(z0, z1), rvec4(tHit))) * (1.0 + 8.0 * UNIT_ROUNDOFF);
+        bvec4 enters = bvec4(uvec4(lessThanEqual(enter, leave)) & uvec4(notEqual(child, uvec4(SNELL_BVH_EMPTY))));
+        // Children missed sort last, at +inf (an entered box's entry is finite).
+        real never = real(uintBitsToFloat(0x7f800000u));
+        rvec4 key = mix(rvec4(never), enter, enters);
+        real k0 = key.x, k1 = key.y, k2 = key.z, k3 = key.w;
+        uint c0 = child.x, c1 = child.y, c2 = child.z, c3 = child.w;
+        // A sorting network of four.
+        orderPair(k0, c0, k1, c1);
+        orderPair(k2, c2, k3, c3);
+        orderPair(k0, c0, k2, c2);
+        orderPair(k1, c1, k3, c3);
+        orderPair(k1, c1, k2, c2);
+        pushEntry(c3, k3 < never, depth);
+        pushEntry(c2, k2 < never, depth);
+        pushEntry(c1, k1 < never, depth);
+        if (k0 < never) entry = c0;
+        else if (depth > 0u) entry = popEntry(depth);
+        else walking = false;
+    }
+    if (walking && (entry & SNELL_BVH_LEAF) != 0u) {
+        // A leaf: spheres first · 4 + count − 1 = code.
+        uint code = entry & ~SNELL_BVH_LEAF;
+        uint first = code >> 2;
+        uint last = first + (code & 3u);
+        [[unroll]] for (uint k = 0u; k < SNELL_BVH_MAX_LEAF; ++k) {
+            uint i = first + k;
+            if (i <= last) {
+                real t = intersectSphere(i, origin, originLength, dir, fromSphere, start);
+                if (t < tHit) { tHit = t; hit = i; }
+            }
+        }
+        if ((anyHit && hit != NONE) || depth == 0u) walking = false;
+        else entry = popEntry(depth);
+    }
+}
+
 uint traverseBvh(rvec3 origin, real originLength, rvec3 dir, uint fromSphere, uint start, bool anyHit,
                  inout real tHit) {
     rvec3 inverseDir = safeInverse(dir);
     uint hit = NONE;
-    uint entry = 0u;  // in hand: a node's index, or SNELL_BVH_LEAF | a leaf's code
-    uint depth = 0u;  // entries on the stack
+    uint entry = 0u;
+    uint depth = 0u;
     bool walking = true;
     while (walking) {
         tick(1u);
         if (COUNT_LANES) countLanes(true, walkSlots, walkBusy);
-        // A pass takes an inner node, then the leaf in hand if there is one
-        // (the node's nearest child, or the next waiting entry): one pass for
-        // both, so lanes at leaves and lanes at nodes go on together.
-        if ((entry & SNELL_BVH_LEAF) == 0u) {
-            int base = int(entry) * SNELL_BVH_NODE_TEXELS;
-            rvec4 x0 = (nodeVector(base) - origin.x) * inverseDir.x;
-            rvec4 x1 = (nodeVector(base + 1) - origin.x) * inverseDir.x;
-            rvec4 y0 = (nodeVector(base + 2) - origin.y) * inverseDir.y;
-            rvec4 y1 = (nodeVector(base + 3) - origin.y) * inverseDir.y;
-            rvec4 z0 = (nodeVector(base + 4) - origin.z) * inverseDir.z;
-            rvec4 z1 = (nodeVector(base + 5) - origin.z) * inverseDir.z;
-            uvec4 child = bvhWord(base + 6);
-            // The slab test within [0, tHit] against boxes stored rounded outwards;
-            // Ize, "Robust BVH Ray Traversal" (JCGT 2013): the exit distance is
-            // widened so rounding never culls a box the ray touches.
-            rvec4 enter = max(max(min(x0, x1), min(y0, y1)), max(min(z0, z1), rvec4(0.0)));
-            rvec4 leave = min(min(max(x0, x1), max(y0, y1)), min(max(z0, z1), rvec4(tHit))) * (1.0 + 8.0 * UNIT_ROUNDOFF);
-            bvec4 enters = bvec4(uvec4(lessThanEqual(enter, leave)) & uvec4(notEqual(child, uvec4(SNELL_BVH_EMPTY))));
-            // Children missed sort last, at +inf (an entered box's entry is finite).
-            real never = real(uintBitsToFloat(0x7f800000u));
-            rvec4 key = mix(rvec4(never), enter, enters);
-            real k0 = key.x, k1 = key.y, k2 = key.z, k3 = key.w;
-            uint c0 = child.x, c1 = child.y, c2 = child.z, c3 = child.w;
-            // A sorting network of four.
-            orderPair(k0, c0, k1, c1);
-            orderPair(k2, c2, k3, c3);
-            orderPair(k0, c0, k2, c2);
-            orderPair(k1, c1, k3, c3);
-            orderPair(k1, c1, k2, c2);
-            pushEntry(c3, k3 < never, depth);
-            pushEntry(c2, k2 < never, depth);
-            pushEntry(c1, k1 < never, depth);
-            if (k0 < never) entry = c0;
-            else if (depth > 0u) entry = popEntry(depth);
-            else walking = false;
-        }
-        if (walking && (entry & SNELL_BVH_LEAF) != 0u) {
-            // A leaf: spheres first · 4 + count − 1 = code.
-            uint code = entry & ~SNELL_BVH_LEAF;
-            uint first = code >> 2;
-            uint last = first + (code & 3u);
-            [[unroll]] for (uint k = 0u; k < SNELL_BVH_MAX_LEAF; ++k) {
-                uint i = first + k;
-                if (i <= last) {
-                    real t = intersectSphere(i, origin, originLength, dir, fromSphere, start);
-                    if (t < tHit) { tHit = t; hit = i; }
-                }
-            }
-            if ((anyHit && hit != NONE) || depth == 0u) walking = false;
-            else entry = popEntry(depth);
-        }
+        walkPass(entry, depth, walking, tHit, hit, origin, originLength, dir, inverseDir, fromSphere, start, anyHit);
     }
     return hit;
 }
@@ -561,20 +571,156 @@ bool findHit(Ray r, vec3 weight, inout vec3 sum, out Hit h) {
     return true;
 }
 
-// 3. Light j's part of the local Phong term with binary shadows (SPEC §4.3).
-vec3 shadeLight(uint j, Hit h, rvec3 v, inout uint shadowRays) {
-    rvec3 l = lightPosition(j) - h.point;
+// 3. Light j's part of the local Phong term (SPEC §4.3) where the light is
+// seen: l, the unit vector towards it, with n·l = nl > 0; v towards the eye.
+vec3 lightTerm(uint j, Hit h, rvec3 l, float nl, rvec3 v) {
+    float rv = float(dot(2.0 * dot(h.normal, l) * h.normal - l, v));
+    float specular = rv > 0.0 ? pow(rv, h.kd.w) : 0.0;
+    return lightColour(j) * (h.kd.rgb * nl + h.ks.rgb * specular);
+}
+// The unit vector l from a point towards light j; returns the distance.
+real lightDirection(uint j, rvec3 point, out rvec3 l) {
+    l = lightPosition(j) - point;
     real distance = length(l);
     l *= 1.0 / distance;  // one division, not three
-    float nl = float(dot(h.normal, l));
+    return distance;
+}
+// The same from hit h, and n·l.
+float towardsLight(uint j, Hit h, out rvec3 l, out real distance) {
+    distance = lightDirection(j, h.point, l);
+    return float(dot(h.normal, l));
+}
+// Light j's part of the local term with binary shadows (SPEC §4.3).
+vec3 shadeLight(uint j, Hit h, rvec3 v, inout uint shadowRays) {
+    rvec3 l;
+    real distance;
+    float nl = towardsLight(j, h, l, distance);
     if (!(nl > 0.0)) return vec3(0.0);
     if (COUNT_RAYS && SHADOWS) countedRays[SNELL_COUNTER_SHADOW]++;
     if (SHADOWS) shadowRays++;
     // A shadow ray towards N's side enters the hit sphere only when N = −No.
     if (SHADOWS && occluded(h.point, l, distance, h.sphere, h.fromOutside ? LEAVING : ENTERING)) return vec3(0.0);
-    float rv = float(dot(2.0 * dot(h.normal, l) * h.normal - l, v));
-    float specular = rv > 0.0 ? pow(rv, h.kd.w) : 0.0;
-    return lightColour(j) * (h.kd.rgb * nl + h.ks.rgb * specular);
+    return lightTerm(j, h, l, nl, v);
+}
+
+// The position of the n-th (from 0) set bit of x: a binary search.
+uint nthSetBit(uint x, uint n) {
+    uint position = 0u;
+    [[unroll]] for (uint width = 16u; width > 0u; width >>= 1u) {
+        uint below = uint(bitCount(x & ((1u << width) - 1u)));
+        if (n >= below) {
+            n -= below;
+            x >>= width;
+            position += width;
+        }
+    }
+    return position;
+}
+
+// What a lane that walks another's shadow ray needs of that lane's hit:
+// the point and its length, the sphere and how the ray starts on it. A slot
+// for each invocation of the workgroup, by subgroup and lane.
+shared rvec4 sharedHitPoint[SNELL_WORKGROUP_SIZE];
+shared uint sharedHitSphere[SNELL_WORKGROUP_SIZE];
+uint sharedSlot(uint lane) { return gl_SubgroupID * gl_SubgroupSize + lane; }
+
+// The lights' part of the local term of a hit, the subgroup's shadow rays
+// shared out among its lanes. In the lights' own loop a lane walks only its
+// own shadow ray, so a lane whose ray missed, whose light is behind its
+// surface or whose ray leaves through its own sphere idles while the others
+// walk (on SphereFlake2 1.6 lanes of 8 walked on average, 19 % of the lane
+// slots of those walks busy). Here the lights go in batches of
+// 32 / subgroup-size (the host enables this for subgroups of up to 16
+// lanes): bit lane · batch + b of `casting` says that the lane casts a ray to
+// the batch's light b, and the k-th of those rays is walked by the
+// (k mod n)-th of the n lanes still in the pixel loop, each walking its rays
+// one after another in one loop. No lane talks to another inside the walk
+// (rays handed out there to whichever lanes were idle, by ballots and
+// shuffles, cost more than they saved on lavapipe; docs/performance.md): a
+// lane reads the hit of the ray's owner from workgroup memory, and after the
+// walk one reduction tells each owner, by the same bits, which of its rays
+// were blocked. It adds each seen light's term in light order: the same sums as
+// shadeLight's loop. (Without a loop budget only: a dispatch cannot suspend
+// in the middle of a walk.)
+void shadeLightsShared(inout SlotState state, Ray r, vec3 weight, Hit h, bool shading, inout uint shadowRays) {
+    rvec3 v = -r.dir;
+    // A shadow ray towards N's side enters the hit sphere only when N = −No.
+    uint start = h.fromOutside ? LEAVING : ENTERING;
+    real originLength = length(h.point);
+    const uint size = gl_SubgroupSize;
+    const uint lane = gl_SubgroupInvocationID;
+    const uint batch = min(4u, 32u / size);
+    if (shading) {
+        sharedHitPoint[sharedSlot(lane)] = rvec4(h.point, originLength);
+        sharedHitSphere[sharedSlot(lane)] = h.sphere * 4u + start;
+    }
+    subgroupMemoryBarrierShared();
+    // The walkers: every lane still in the pixel loop, in lane order.
+    uint inLoop = subgroupOr(1u << lane);
+    const uint walkers = uint(bitCount(inLoop)), walkerRank = uint(bitCount(inLoop & ((1u << lane) - 1u)));
+    for (uint firstLight = 0u; firstLight < frame.lightCount; firstLight += batch) {
+        // The rays to walk: those towards lights the surface faces, less those
+        // that cross the hit sphere first (occluded's first test).
+        uint facing = 0u, casting = 0u;
+        [[unroll]] for (uint b = 0u; b < 4u; ++b) {
+            bool walks = false;
+            if (shading && b < batch && firstLight + b < frame.lightCount) {
+                rvec3 l;
+                real distance;
+                if (towardsLight(firstLight + b, h, l, distance) > 0.0) {
+                    if (COUNT_RAYS) countedRays[SNELL_COUNTER_SHADOW]++;
+                    shadowRays++;
+                    facing |= 1u << b;
+                    walks = !(start == ENTERING &&
+                              intersectSphere(h.sphere, h.point, originLength, l, h.sphere, start) < distance);
+                }
+            }
+            if (walks) casting |= 1u << b;
+        }
+        casting = subgroupOr(casting << (lane * batch));
+        uint rays = uint(bitCount(casting));
+        uint walkedBlocked = 0u;
+        uint ray = walkerRank, bit = 0u, entry = 0u, depth = 0u, hit = NONE, fromSphere = 0u, fromStart = 0u;
+        rvec3 origin = rvec3(0.0), l = rvec3(0.0), inverseDir = rvec3(0.0);
+        real distance = 0.0, rayOriginLength = 0.0;
+        bool walking = ray < rays, begins = walking;
+        while (walking) {
+            if (begins) {
+                begins = false;
+                // A ray to begin: its owner's hit, and the direction to its light.
+                bit = nthSetBit(casting, ray);
+                rvec4 point = sharedHitPoint[sharedSlot(bit / batch)];
+                uint from = sharedHitSphere[sharedSlot(bit / batch)];
+                origin = point.xyz;
+                rayOriginLength = point.w;
+                fromSphere = from >> 2;
+                fromStart = from & 3u;
+                distance = lightDirection(firstLight + bit % batch, origin, l);
+                inverseDir = safeInverse(l);
+                hit = NONE;
+            }
+            if (COUNT_LANES) countLanes(true, walkSlots, walkBusy);
+            walkPass(entry, depth, walking, distance, hit, origin, rayOriginLength, l, inverseDir, fromSphere,
+                     fromStart, true);
+            if (!walking) {
+                if (hit != NONE) walkedBlocked |= 1u << bit;
+                ray += walkers;
+                walking = begins = ray < rays;
+                entry = 0u;
+                depth = 0u;
+            }
+        }
+        uint blocked = subgroupOr(walkedBlocked);
+        // Each lane's seen lights, in light order.
+        [[unroll]] for (uint b = 0u; b < 4u; ++b) {
+            uint mine = 1u << (lane * batch + b);
+            if (((facing >> b) & 1u) == 0u || (casting & mine) == 0u || (blocked & mine) != 0u) continue;
+            rvec3 toLight;
+            real lightDistance;
+            float nl = towardsLight(firstLight + b, h, toLight, lightDistance);
+            state.sum.rgb += weighted(weight, lightTerm(firstLight + b, h, toLight, nl, v));
+        }
+    }
 }
 
 // What a step of a pixel proves of its exact colour: its colour is a lower
@@ -1063,6 +1209,13 @@ bool traceRay(uint slot, inout SlotState state, inout Ray r, float cutOff, out v
 // light some lane still needs, so every dispatch moves on. Returns true where
 // the budget suspended it (r then waits to resume at the next light).
 bool shadeLights(inout SlotState state, inout Ray r, vec3 weight, Hit h, bool shading, inout uint shadowRays) {
+#ifndef SNELL_RAY_QUERY
+    // Every lane, shading or not, walks the subgroup's shadow rays.
+    if (HAS_LIGHTS && SHARE_SHADOW_RAYS && USE_BVH && SHADOWS && LOOP_BUDGET == 0u) {
+        shadeLightsShared(state, r, weight, h, shading, shadowRays);
+        return false;
+    }
+#endif
     if (!HAS_LIGHTS || !(shading || LOOP_BUDGET != 0u)) return false;
     rvec3 v = -r.dir;
     uint firstLight = LOOP_BUDGET != 0u ? subgroupMin(shading ? max(r.resumeShading, 1u) - 1u : frame.lightCount) : 0u;

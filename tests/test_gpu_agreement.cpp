@@ -667,6 +667,25 @@ TEST(GpuBvhStack, RegistersTraceTheArraysImage) {
                        "the two stacks");
 }
 
+// The shadow rays of a subgroup's hits are walked by all its lanes, or each
+// by its own lane in the lights' loop (trace.comp, shadeLightsShared): both
+// trace the same image, bit for bit. Every scene here has more than one
+// light; SphereFlake2 sends most shadow rays from inside its glass spheres.
+TEST(GpuShadowRays, SharedTraceTheOwnRaysImage) {
+    // Where the driver ends long loops the walk must be able to suspend, so
+    // the rays are never shared there; elsewhere on a CPU device they are.
+    const bool shares = context().isCpuDevice() && !snell::limitsLoopIterations(context());
+    requireTheSameWalk({{SNELL_SOURCE_DIR "/scenes/grid.scn", snell::gpu::Precision::Fp32},
+                        {SNELL_SOURCE_DIR "/scenes/grid.scn", snell::gpu::Precision::Fp64},
+                        {SNELL_SHARED_DIR "/course-scenes/becker-SphereFlake2.scn", snell::gpu::Precision::Fp32},
+                        {SNELL_SHARED_DIR "/course-scenes/becker-SphereFlake3.scn", snell::gpu::Precision::Fp32}},
+                       [shares](snell::ComputeRenderer& renderer, bool share) {
+                           renderer.shareShadowRays(share);
+                           EXPECT_EQ(renderer.sharesShadowRays(), share && shares);
+                       },
+                       "shared and own shadow rays");
+}
+
 TEST(GpuPlan, TracesTheImageOfLavapipesPlan) {
     for (const char* file : {SNELL_SOURCE_DIR "/scenes/grid.scn", SNELL_SOURCE_DIR "/scenes/glass.scn"}) {
         SCOPED_TRACE(file);

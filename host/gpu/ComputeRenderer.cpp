@@ -106,6 +106,12 @@ ComputeRenderer::ComputeRenderer(vk::Context& context, const Scene& scene, const
     // a GPU keeps such a stack in its local memory (unmeasured there: left
     // as it was). docs/performance.md, "The walk's stack in registers".
     stackInRegisters_ = context.isCpuDevice();
+    // A batch of shadow rays is numbered within 32 bits, 32 / subgroup size
+    // lights at a time: worth it for SIMD rows of 8 or 16 lanes. Measured on
+    // lavapipe only (a GPU's lanes would also need a subgroup barrier before
+    // they read each other's hits; docs/performance.md, "Shadow rays shared
+    // out").
+    shareShadowRays_ = context.isCpuDevice() && context.subgroupSize() >= 2 && context.subgroupSize() <= 16;
     loopBudget_ = limitsLoopIterations(context) ? SNELL_LOOP_BUDGET_LIMITED : 0u;
     // Each scene array becomes a texel buffer (shared_layout.h): its structs
     // are runs of RGBA32 texels (R32 for a uint array).
@@ -167,6 +173,13 @@ bool ComputeRenderer::bvhFitsWords() const {
 
 bool ComputeRenderer::stackInRegisters() const {
     return stackInRegisters_ && layout_.usesBvh() && layout_.bvhStackSize() <= SNELL_REGISTER_STACK_LIMIT;
+}
+
+bool ComputeRenderer::sharesShadowRays() const {
+    // Only with snell's own walk and more than one light (one shadow ray a
+    // lane has no one to share with), and where the walk cannot be suspended
+    // (the shadow rays of a batch are walked in one loop).
+    return shareShadowRays_ && layout_.usesBvh() && layout_.lights.size() > 1 && !sphereBoxes_ && loopBudget_ == 0u;
 }
 
 const char* ComputeRenderer::traversal() const {
@@ -249,6 +262,7 @@ ComputeRenderer::Specialisation ComputeRenderer::specialise(const RenderRequest&
             if (layout_.spheres[i].anchorRadius.w < 0.0f) values[SNELL_SPEC_ELLIPSOID_MASK] |= 1u << i;
     values[SNELL_SPEC_BVH_DEPTH] = static_cast<std::uint32_t>(layout_.bvhStackSize());
     values[SNELL_SPEC_STACK_IN_REGISTERS] = stackInRegisters();
+    values[SNELL_SPEC_SHARE_SHADOW_RAYS] = sharesShadowRays();
     values[SNELL_SPEC_HAS_ELLIPSOIDS] = !layout_.ellipsoids.empty();
     values[SNELL_SPEC_HAS_REFRACTION] = hasRefraction;
     values[SNELL_SPEC_HAS_REFLECTION] = hasReflection;

@@ -108,6 +108,12 @@ public:
     // a per-lane index. The image is the same either way.
     void keepStackInRegisters(bool registers) { stackInRegisters_ = registers; }
     bool stackInRegisters() const;  // the walk's stack is in registers (this scene, this setting)
+    // Testing: whether the shadow rays of a subgroup's hits are shared out
+    // among all its lanes (trace.comp, shadeLightsShared; by default where
+    // the device allows it), or each lane walks its own in the lights' loop.
+    // The image is the same either way.
+    void shareShadowRays(bool share) { shareShadowRays_ = share; }
+    bool sharesShadowRays() const;  // this scene's shadow rays are shared out (this device, this setting)
     // With false, the kernel is a pipeline even where the device has shader
     // objects (vulkan/ShaderObject.h). The image is the same either way.
     void useShaderObjects(bool use) { useShaderObjects_ = use; }
@@ -157,6 +163,7 @@ private:
     bool useShaderObjects_ = true;
     bool bvhWords_ = false;
     bool stackInRegisters_ = false;
+    bool shareShadowRays_ = false;
     std::uint32_t loopBudget_ = 0;  // where the driver ends long loops (gpu/DriverProbe.h), else 0
     bool countLanes_ = false;
     double uploadMs_ = 0.0;

@@ -320,10 +320,12 @@ Context::Context(const ContextOptions& options) : fault_(options.fault) {
         deviceName_ = reports_[best].name;
         driverInfo_ = reports_[best].driver;
         vkGetPhysicalDeviceProperties(physical_, &properties_);
-        VkPhysicalDeviceDriverProperties driver{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES};
+        VkPhysicalDeviceSubgroupProperties subgroup{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES};
+        VkPhysicalDeviceDriverProperties driver{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_DRIVER_PROPERTIES, &subgroup};
         VkPhysicalDeviceProperties2 props2{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, &driver};
         vkGetPhysicalDeviceProperties2(physical_, &props2);
         driverId_ = driver.driverID;
+        subgroupSize_ = subgroup.subgroupSize;
         vkGetPhysicalDeviceMemoryProperties(physical_, &memory_);
         std::uint32_t count = 0;
         vkGetPhysicalDeviceQueueFamilyProperties(physical_, &count, nullptr);

@@ -130,6 +130,8 @@ public:
     // Shader objects (ContextOptions::shaderObjects): enabled, or why not.
     const ShaderObjects& shaderObjects() const { return shaderObjects_; }
     bool isCpuDevice() const { return properties_.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU; }
+    // The lanes of a subgroup (a SIMD row) in compute shaders.
+    std::uint32_t subgroupSize() const { return subgroupSize_; }
     // The size of the largest device-local memory heap.
     VkDeviceSize deviceLocalBytes() const;
     // Mesa's llvmpipe (lavapipe): its shaders end all loops after 65535
@@ -206,6 +208,7 @@ private:
     VkFence fence_ = VK_NULL_HANDLE;
     std::uint32_t queueFamily_ = 0;
     std::uint32_t timestampValidBits_ = 0;
+    std::uint32_t subgroupSize_ = 0;
     bool float64_ = false;
     bool rayQueries_ = false;
     std::string rayQueryAbsence_;
