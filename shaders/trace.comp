@@ -625,23 +625,23 @@ shared uint sharedHitSphere[SNELL_WORKGROUP_SIZE];
 uint sharedSlot(uint lane) { return gl_SubgroupID * gl_SubgroupSize + lane; }
 
 // The lights' part of the local term of a hit, the subgroup's shadow rays
-// shared out among its lanes. In the lights' own loop a lane walks only its
-// own shadow ray, so a lane whose ray missed, whose light is behind its
-// surface or whose ray leaves through its own sphere idles while the others
-// walk (on SphereFlake2 1.6 lanes of 8 walked on average, 19 % of the lane
-// slots of those walks busy). Here the lights go in batches of
-// 32 / subgroup-size (the host enables this for subgroups of up to 16
-// lanes): bit lane · batch + b of `casting` says that the lane casts a ray to
-// the batch's light b, and the k-th of those rays is walked by the
-// (k mod n)-th of the n lanes still in the pixel loop, each walking its rays
-// one after another in one loop. No lane talks to another inside the walk
-// (rays handed out there to whichever lanes were idle, by ballots and
-// shuffles, cost more than they saved on lavapipe; docs/performance.md): a
-// lane reads the hit of the ray's owner from workgroup memory, and after the
-// walk one reduction tells each owner, by the same bits, which of its rays
-// were blocked. It adds each seen light's term in light order: the same sums as
-// shadeLight's loop. (Without a loop budget only: a dispatch cannot suspend
-// in the middle of a walk.)
+// shared out among its lanes. In the lights' own loop a lane walks only its own
+// shadow ray, so a lane whose ray missed, whose light is behind its surface or
+// whose ray leaves through its own sphere idles while the others walk (on
+// SphereFlake2 1.6 lanes of 8 walked on average, 19 % of the lane slots of
+// those walks busy). Here the lights go in batches of min(4, 32 / subgroup
+// size) (the host enables this for subgroups of up to 16 lanes, so a subgroup's
+// slots below lie within the workgroup): bit lane · batch + b of `casting` says
+// that the lane casts a ray to the batch's light b, and the k-th of those rays
+// is walked by the (k mod n)-th of the n lanes still in the pixel loop, each
+// walking its rays one after another in one loop. No lane talks to another
+// inside the walk (rays handed out there to whichever lanes were idle, by
+// ballots and shuffles, cost more than they saved on lavapipe;
+// docs/performance.md): a lane reads the hit of the ray's owner from workgroup
+// memory, and after the walk one reduction tells each owner, by the same bits,
+// which of its rays were blocked. It adds each seen light's term in light
+// order: the same sums as shadeLight's loop. (Without a loop budget only: a
+// dispatch cannot suspend in the middle of a walk.)
 void shadeLightsShared(inout SlotState state, Ray r, vec3 weight, Hit h, bool shading, inout uint shadowRays) {
     rvec3 v = -r.dir;
     // A shadow ray towards N's side enters the hit sphere only when N = −No.

@@ -670,7 +670,7 @@ TEST(GpuBvhStack, RegistersTraceTheArraysImage) {
 // The shadow rays of a subgroup's hits are walked by all its lanes, or each
 // by its own lane in the lights' loop (trace.comp, shadeLightsShared): both
 // trace the same image, bit for bit. Every scene here has more than one
-// light; SphereFlake2 sends most shadow rays from inside its glass spheres.
+// light; in SphereFlake2's glass few lanes of a subgroup cast shadow rays.
 TEST(GpuShadowRays, SharedTraceTheOwnRaysImage) {
     // Where the driver ends long loops the walk must be able to suspend, so
     // the rays are never shared there; elsewhere on a CPU device they are.
