@@ -363,15 +363,18 @@ uint closestHit(rvec3 origin, rvec3 dir, uint fromSphere, uint start, out real t
 
 // SPEC §4.3 visibility: does any surface cross the open segment (0, distance)?
 // Stops at the first occluder.
+// A ray that starts on a sphere headed into it (shading a hit from inside)
+// crosses that sphere at its chord unless the light is nearer: that one test
+// first spares the search its answer. (Not where the spheres are unrolled: a
+// dynamic index into them costs more than it spares.)
+bool crossesOwnSphere(rvec3 origin, real originLength, rvec3 dir, real distance, uint fromSphere, uint start) {
+    return (USE_BVH || SPHERE_COUNT == 0u) && start == ENTERING &&
+           intersectSphere(fromSphere, origin, originLength, dir, fromSphere, start) < distance;
+}
+
 bool occluded(rvec3 origin, rvec3 dir, real distance, uint fromSphere, uint start) {
     real originLength = length(origin);
-    // A ray that starts on a sphere headed into it (shading a hit from inside)
-    // crosses that sphere at its chord unless the light is nearer: that one
-    // test first spares the search its answer. (Not where the spheres are
-    // unrolled: a dynamic index into them costs more than it spares.)
-    if ((USE_BVH || SPHERE_COUNT == 0u) && start == ENTERING &&
-        intersectSphere(fromSphere, origin, originLength, dir, fromSphere, start) < distance)
-        return true;
+    if (crossesOwnSphere(origin, originLength, dir, distance, fromSphere, start)) return true;
     if (USE_BVH) return searchBvh(origin, originLength, dir, fromSphere, start, true, distance) != NONE;
     bool blocked = false;
     if (SPHERE_COUNT > 0u) {
@@ -590,6 +593,10 @@ float towardsLight(uint j, Hit h, out rvec3 l, out real distance) {
     distance = lightDirection(j, h.point, l);
     return float(dot(h.normal, l));
 }
+// How a shadow ray from hit h starts on its sphere: towards N's side it
+// enters the sphere only when N = −No (the hit was from inside).
+uint shadowStart(Hit h) { return h.fromOutside ? LEAVING : ENTERING; }
+
 // Light j's part of the local term with binary shadows (SPEC §4.3).
 vec3 shadeLight(uint j, Hit h, rvec3 v, inout uint shadowRays) {
     rvec3 l;
@@ -598,8 +605,7 @@ vec3 shadeLight(uint j, Hit h, rvec3 v, inout uint shadowRays) {
     if (!(nl > 0.0)) return vec3(0.0);
     if (COUNT_RAYS && SHADOWS) countedRays[SNELL_COUNTER_SHADOW]++;
     if (SHADOWS) shadowRays++;
-    // A shadow ray towards N's side enters the hit sphere only when N = −No.
-    if (SHADOWS && occluded(h.point, l, distance, h.sphere, h.fromOutside ? LEAVING : ENTERING)) return vec3(0.0);
+    if (SHADOWS && occluded(h.point, l, distance, h.sphere, shadowStart(h))) return vec3(0.0);
     return lightTerm(j, h, l, nl, v);
 }
 
@@ -617,6 +623,7 @@ uint nthSetBit(uint x, uint n) {
     return position;
 }
 
+#ifndef SNELL_RAY_QUERY  // (shared shadow rays walk snell's own BVH)
 // What a lane that walks another's shadow ray needs of that lane's hit:
 // the point and its length, the sphere and how the ray starts on it. A slot
 // for each invocation of the workgroup, by subgroup and lane.
@@ -630,22 +637,23 @@ uint sharedSlot(uint lane) { return gl_SubgroupID * gl_SubgroupSize + lane; }
 // whose ray leaves through its own sphere idles while the others walk (on
 // SphereFlake2 1.6 lanes of 8 walked on average, 19 % of the lane slots of
 // those walks busy). Here the lights go in batches of min(4, 32 / subgroup
-// size) (the host enables this for subgroups of up to 16 lanes, so a subgroup's
-// slots below lie within the workgroup): bit lane · batch + b of `casting` says
-// that the lane casts a ray to the batch's light b, and the k-th of those rays
-// is walked by the (k mod n)-th of the n lanes still in the pixel loop, each
-// walking its rays one after another in one loop. No lane talks to another
-// inside the walk (rays handed out there to whichever lanes were idle, by
-// ballots and shuffles, cost more than they saved on lavapipe;
-// docs/performance.md): a lane reads the hit of the ray's owner from workgroup
-// memory, and after the walk one reduction tells each owner, by the same bits,
-// which of its rays were blocked. It adds each seen light's term in light
-// order: the same sums as shadeLight's loop. (Without a loop budget only: a
-// dispatch cannot suspend in the middle of a walk.)
+// size): bit lane · batch + b of `casting` says that the lane casts a ray to
+// the batch's light b, and the k-th of those rays is walked by the (k mod n)-th
+// of the n lanes still in the pixel loop, each walking its rays one after
+// another in one loop. No lane talks to another inside the walk (rays handed
+// out there to whichever lanes were idle, by ballots and shuffles, cost more
+// than they saved on lavapipe; docs/performance.md): a lane reads the hit of
+// the ray's owner from workgroup memory, and after the walk one reduction tells
+// each owner, by the same bits, which of its rays were blocked. It adds each
+// seen light's term in light order: the same sums as shadeLight's loop. The
+// host enables this on CPU devices with subgroups of up to 16 lanes only: there
+// a subgroup's lanes run in lockstep, so each sees the others' hits once
+// written and all meet again at the reductions after the walk (a GPU would need
+// subgroup barriers), and its slots below lie within the workgroup. And without
+// a loop budget only: a dispatch cannot suspend in the middle of a walk.
 void shadeLightsShared(inout SlotState state, Ray r, vec3 weight, Hit h, bool shading, inout uint shadowRays) {
     rvec3 v = -r.dir;
-    // A shadow ray towards N's side enters the hit sphere only when N = −No.
-    uint start = h.fromOutside ? LEAVING : ENTERING;
+    uint start = shadowStart(h);
     real originLength = length(h.point);
     const uint size = gl_SubgroupSize;
     const uint lane = gl_SubgroupInvocationID;
@@ -660,8 +668,8 @@ void shadeLightsShared(inout SlotState state, Ray r, vec3 weight, Hit h, bool sh
     const uint walkers = uint(bitCount(inLoop)), walkerRank = uint(bitCount(inLoop & ((1u << lane) - 1u)));
     for (uint firstLight = 0u; firstLight < frame.lightCount; firstLight += batch) {
         // The rays to walk: those towards lights the surface faces, less those
-        // that cross the hit sphere first (occluded's first test).
-        uint facing = 0u, casting = 0u;
+        // that cross the hit sphere first.
+        uint casting = 0u;
         [[unroll]] for (uint b = 0u; b < 4u; ++b) {
             bool walks = false;
             if (shading && b < batch && firstLight + b < frame.lightCount) {
@@ -670,9 +678,7 @@ void shadeLightsShared(inout SlotState state, Ray r, vec3 weight, Hit h, bool sh
                 if (towardsLight(firstLight + b, h, l, distance) > 0.0) {
                     if (COUNT_RAYS) countedRays[SNELL_COUNTER_SHADOW]++;
                     shadowRays++;
-                    facing |= 1u << b;
-                    walks = !(start == ENTERING &&
-                              intersectSphere(h.sphere, h.point, originLength, l, h.sphere, start) < distance);
+                    walks = !crossesOwnSphere(h.point, originLength, l, distance, h.sphere, start);
                 }
             }
             if (walks) casting |= 1u << b;
@@ -711,10 +717,12 @@ void shadeLightsShared(inout SlotState state, Ray r, vec3 weight, Hit h, bool sh
             }
         }
         uint blocked = subgroupOr(walkedBlocked);
-        // Each lane's seen lights, in light order.
+        // Each lane's seen lights, in light order: those it cast a ray to
+        // (so its surface faces them) that nothing blocked.
         [[unroll]] for (uint b = 0u; b < 4u; ++b) {
+            if (b >= batch) continue;
             uint mine = 1u << (lane * batch + b);
-            if (((facing >> b) & 1u) == 0u || (casting & mine) == 0u || (blocked & mine) != 0u) continue;
+            if ((casting & mine) == 0u || (blocked & mine) != 0u) continue;
             rvec3 toLight;
             real lightDistance;
             float nl = towardsLight(firstLight + b, h, toLight, lightDistance);
@@ -722,6 +730,7 @@ void shadeLightsShared(inout SlotState state, Ray r, vec3 weight, Hit h, bool sh
         }
     }
 }
+#endif
 
 // What a step of a pixel proves of its exact colour: its colour is a lower
 // bound and its colour plus the weight it has not traced times the radiance
@@ -1211,7 +1220,7 @@ bool traceRay(uint slot, inout SlotState state, inout Ray r, float cutOff, out v
 bool shadeLights(inout SlotState state, inout Ray r, vec3 weight, Hit h, bool shading, inout uint shadowRays) {
 #ifndef SNELL_RAY_QUERY
     // Every lane, shading or not, walks the subgroup's shadow rays.
-    if (HAS_LIGHTS && SHARE_SHADOW_RAYS && USE_BVH && SHADOWS && LOOP_BUDGET == 0u) {
+    if (HAS_LIGHTS && SHARE_SHADOW_RAYS && USE_BVH && SHADOWS && LOOP_BUDGET == 0u && gl_SubgroupSize <= 16u) {
         shadeLightsShared(state, r, weight, h, shading, shadowRays);
         return false;
     }

@@ -106,12 +106,13 @@ ComputeRenderer::ComputeRenderer(vk::Context& context, const Scene& scene, const
     // a GPU keeps such a stack in its local memory (unmeasured there: left
     // as it was). docs/performance.md, "The walk's stack in registers".
     stackInRegisters_ = context.isCpuDevice();
-    // A batch of shadow rays is numbered within 32 bits, 32 / subgroup size
-    // lights at a time: worth it for SIMD rows of 8 or 16 lanes. Measured on
-    // lavapipe only (a GPU's lanes would also need a subgroup barrier before
-    // they read each other's hits; docs/performance.md, "Shadow rays shared
-    // out").
-    shareShadowRays_ = context.isCpuDevice() && context.subgroupSize() >= 2 && context.subgroupSize() <= 16;
+    // A batch of shadow rays is numbered within 32 bits, min(4, 32 / subgroup
+    // size) lights at a time: worth it for SIMD rows of up to 16 lanes. On a
+    // CPU device only, where a subgroup's lanes run in lockstep: a GPU's would
+    // also need to meet at a subgroup barrier before they read each other's
+    // hits, and it is unmeasured there (docs/performance.md, "Shadow rays
+    // shared out").
+    deviceSharesShadowRays_ = context.isCpuDevice() && context.subgroupSize() >= 2 && context.subgroupSize() <= 16;
     loopBudget_ = limitsLoopIterations(context) ? SNELL_LOOP_BUDGET_LIMITED : 0u;
     // Each scene array becomes a texel buffer (shared_layout.h): its structs
     // are runs of RGBA32 texels (R32 for a uint array).
@@ -179,7 +180,8 @@ bool ComputeRenderer::sharesShadowRays() const {
     // Only with snell's own walk and more than one light (one shadow ray a
     // lane has no one to share with), and where the walk cannot be suspended
     // (the shadow rays of a batch are walked in one loop).
-    return shareShadowRays_ && layout_.usesBvh() && layout_.lights.size() > 1 && !sphereBoxes_ && loopBudget_ == 0u;
+    return shareShadowRays_ && deviceSharesShadowRays_ && layout_.usesBvh() && layout_.lights.size() > 1 &&
+           !sphereBoxes_ && loopBudget_ == 0u;
 }
 
 const char* ComputeRenderer::traversal() const {

@@ -108,10 +108,10 @@ public:
     // a per-lane index. The image is the same either way.
     void keepStackInRegisters(bool registers) { stackInRegisters_ = registers; }
     bool stackInRegisters() const;  // the walk's stack is in registers (this scene, this setting)
-    // Testing: whether the shadow rays of a subgroup's hits are shared out
-    // among all its lanes (trace.comp, shadeLightsShared; by default where
-    // the device allows it), or each lane walks its own in the lights' loop.
-    // The image is the same either way.
+    // Testing: whether the shadow rays of a subgroup's hits may be shared out
+    // among all its lanes (trace.comp, shadeLightsShared; by default they
+    // are, where the device and scene allow it), or each lane walks its own
+    // in the lights' loop. The image is the same either way.
     void shareShadowRays(bool share) { shareShadowRays_ = share; }
     bool sharesShadowRays() const;  // this scene's shadow rays are shared out (this device, this setting)
     // With false, the kernel is a pipeline even where the device has shader
@@ -163,7 +163,8 @@ private:
     bool useShaderObjects_ = true;
     bool bvhWords_ = false;
     bool stackInRegisters_ = false;
-    bool shareShadowRays_ = false;
+    bool shareShadowRays_ = true;
+    bool deviceSharesShadowRays_ = false;  // a CPU device with subgroups of up to 16 lanes
     std::uint32_t loopBudget_ = 0;  // where the driver ends long loops (gpu/DriverProbe.h), else 0
     bool countLanes_ = false;
     double uploadMs_ = 0.0;
