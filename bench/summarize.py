@@ -76,6 +76,14 @@ def tables(d):
                   f"{ms(p['first_image_cold_ms'])} / {ms(p['first_image_warm_ms'])} | {ms(p['cpu_reference_ms'])} | "
                   f"{ms(pt)} | {ms(pc)} | {trace_ratio} | {command_ratio} |")
 
+    if d.get("walk_floors"):
+        print("\n| BVH scene (depth 0) | size | walk's floor ms | Mrays/s | renderer ms | Mrays/s | renderer / floor |")
+        print("|---|---|---|---|---|---|---|")
+        for w in d["walk_floors"]:
+            f, r = w["floor_kernel_ms"], w["render_depth0_ms"]
+            print(f"| {w['scene']} | {w['size']}² | {ms(f)} | {w['floor_kernel_rays'] / f / 1e3:.1f} | {ms(r)} | "
+                  f"{w['render_depth0_rays'] / r / 1e3:.1f} | {r / f:.2f}× |")
+
     if d["scaling"]:
         print("\n| spheres | parse ms | BVH build ms | render ms (median, min–max) | scene on the GPU MiB | peak RSS MiB |")
         print("|---|---|---|---|---|---|")

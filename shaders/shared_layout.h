@@ -13,11 +13,12 @@
 // the documented limit of 4 000 000 spheres fits where 128 MiB of storage
 // buffer does not. Integers that ride in a vec4 are stored as the bits of a
 // uint and read through an RGBA32UI view: no float conversion, exact. The
-// BVH can also be read as a storage buffer: Mesa 25's lavapipe calls a
-// function for every texel fetch, which in the walk's seven fetches a node
-// costs more than the loads (docs/performance.md, "The BVH as a storage
-// buffer"). Storage buffers are limited in bytes (128 MiB on lavapipe), and
-// 4 000 000 spheres make 222 MB of nodes: such a BVH is read as texels.
+// BVH can also be read through its buffer's device address
+// (FrameParams.bvhAddress, GL_EXT_buffer_reference): Mesa 25's lavapipe calls
+// a function for every texel fetch, which in the walk's seven fetches a node
+// costs more than loads; and it loads from an address without the per-lane
+// bounds checks of a storage buffer, nor its 128 MiB limit
+// (docs/performance.md, "The BVH as a storage buffer", "The walk's floor").
 #ifndef SNELL_SHARED_LAYOUT_H
 #define SNELL_SHARED_LAYOUT_H
 
@@ -69,10 +70,7 @@ using uint = std::uint32_t;
 // driver's own traversal in place of the BVH walk: one geometry of AABBs,
 // primitive i the box of sphere i, in one instance.
 #define SNELL_BINDING_ACCELERATION 18
-// The BVH's nodes again, the same buffer read as a storage buffer where the
-// driver's loads of it beat its texel fetches (SNELL_SPEC_BVH_WORDS).
-#define SNELL_BINDING_BVH_WORDS 19
-#define SNELL_BINDING_LIMIT 20  // one past the largest binding
+#define SNELL_BINDING_LIMIT 19  // one past the largest binding
 
 // Specialization constants: compile only what a scene uses.
 #define SNELL_SPEC_USE_BVH 0
@@ -94,7 +92,7 @@ using uint = std::uint32_t;
 #define SNELL_SPEC_COUNT_LANES 16  // count the SIMD lanes busy in each loop pass (render --count-lanes)
 #define SNELL_SPEC_TRAPS 17        // some material traps light (render/Truncation.h, growthTraps)
 #define SNELL_SPEC_HELPS 18        // workgroups help with each other's shares of a tile (trace.comp, takePixel)
-#define SNELL_SPEC_BVH_WORDS 19    // the walk reads the BVH as a storage buffer (SNELL_BINDING_BVH_WORDS)
+#define SNELL_SPEC_BVH_WORDS 19    // the walk reads the BVH's nodes through their address (FrameParams.bvhAddress)
 #define SNELL_SPEC_STACK_IN_REGISTERS 20  // the walk's stack in registers (trace.comp, pushEntry)
 #define SNELL_SPEC_SHARE_SHADOW_RAYS 21  // a subgroup's shadow rays walked by all its lanes (trace.comp, shadeLightsShared)
 #define SNELL_SPEC_COUNT 22
@@ -304,7 +302,11 @@ struct FrameParams {
     float amplifiedEstimate;  // the estimated error within which a pixel whose trees met a trap may
                               // stop (render/Truncation.h, kAmplifiedEstimate)
     float airEta;       // the index of refraction outside every sphere (SPEC §4.5)
+    uint bvhAddressLow; // the device address of the BVH's nodes (with SNELL_SPEC_BVH_WORDS), low 32 bits
+    uint bvhAddressHigh;
     uint pad0;
+    uint pad1;
+    uint pad2;
 };
 
 // Interleaved tiles (ComputeRenderer) take the image's columns in runs of a

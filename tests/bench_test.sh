@@ -4,7 +4,8 @@
 # default settings stay within 0.5/255 of the exact image; every scene has a
 # price of the default (finite and positive, or flagged an upper bound) set by
 # a fixed tree of the front, and the summary its geometric mean; the ceiling,
-# the floor, the peers and the scaling curve are there; bench/summarize.py
+# the floor, the walk's floor on the BVH scenes (casting the renderer's
+# rays), the peers and the scaling curve are there; bench/summarize.py
 # makes its tables and plot from them. Not a timed test.
 set -u
 : "${SNELL:?}" "${SOURCE:?}" "${PYTHON:=python3}"
@@ -47,6 +48,15 @@ if not d["peers"]: fail.append("no peers (../shared/bench-scenes)")
 for p in d["peers"]:
     if not (p["snell_dispatch_ms"] > 0 and p["snell_command_ms"] > 0 and p["cpu_reference_ms"] > 0):
         fail.append(f"peer {p}")
+# The walk's floor on each BVH scene: the renderer's walk alone, casting the
+# renderer's rays (the same camera and shadow rays, as counted).
+floors = {w["scene"] for w in d.get("walk_floors", [])}
+for need in ("scenes/grid", "bench/grid"):
+    if need not in floors: fail.append(f"no walk floor for {need}")
+for w in d.get("walk_floors", []):
+    if not (w["floor_kernel_ms"] > 0 and w["render_depth0_ms"] > 0): fail.append(f"walk floor {w}")
+    if abs(w["floor_kernel_rays"] - w["render_depth0_rays"]) > 1e-3 * w["render_depth0_rays"]:
+        fail.append(f"walk floor {w['scene']}: {w['floor_kernel_rays']} rays, the renderer {w['render_depth0_rays']}")
 if [s["spheres"] for s in d["scaling"]] != [10, 100, 1000, 10000]: fail.append("scaling counts")
 for s in d["scaling"]:
     if not s["render_ms"]["median"] > 0: fail.append(f"scaling {s}")

@@ -648,10 +648,10 @@ void requireTheSameWalk(std::initializer_list<WalkCase> cases,
     }
 }
 
-// The BVH walk reads the nodes as texels or as a storage buffer, whichever
-// the driver reads faster (shared_layout.h): both trace the same image, bit
-// for bit, on every driver.
-TEST(GpuBvhWords, StorageReadsTraceTheTexelsImage) {
+// The BVH walk reads the nodes as texels or through their device address,
+// whichever the driver reads faster (shared_layout.h): both trace the same
+// image, bit for bit, on every driver.
+TEST(GpuBvhWords, AddressReadsTraceTheTexelsImage) {
     requireTheSameWalk({{SNELL_SOURCE_DIR "/scenes/grid.scn", snell::gpu::Precision::Fp32},
                         {SNELL_SOURCE_DIR "/scenes/grid.scn", snell::gpu::Precision::Fp64},
                         {SNELL_SHARED_DIR "/course-scenes/becker-SphereFlake2.scn", snell::gpu::Precision::Fp32}},

@@ -73,7 +73,7 @@ glm::vec3 lowerOf(const gpu::BvhNode& n, int k) { return {n.lowerX[k], n.lowerY[
 glm::vec3 upperOf(const gpu::BvhNode& n, int k) { return {n.upperX[k], n.upperY[k], n.upperZ[k]}; }
 
 TEST(Layout, FrameParams) {
-    EXPECT_EQ(sizeof(gpu::FrameParams), 192u);
+    EXPECT_EQ(sizeof(gpu::FrameParams), 208u);
     EXPECT_EQ(offsetof(gpu::FrameParams, primaryStart), 0u);
     EXPECT_EQ(offsetof(gpu::FrameParams, cornerDir), 16u);
     EXPECT_EQ(offsetof(gpu::FrameParams, pixelRight), 32u);
@@ -97,6 +97,8 @@ TEST(Layout, FrameParams) {
     EXPECT_EQ(offsetof(gpu::FrameParams, tolerance), 176u);
     EXPECT_EQ(offsetof(gpu::FrameParams, amplifiedEstimate), 180u);
     EXPECT_EQ(offsetof(gpu::FrameParams, airEta), 184u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, bvhAddressLow), 188u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, bvhAddressHigh), 192u);
 }
 
 TEST(Layout, TileParams) {

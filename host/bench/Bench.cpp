@@ -25,6 +25,8 @@
 #include "ray_sphere_kernel_comp_spv.h"
 #include "ray_sphere_kernel_matrix_comp_spv.h"
 #include "store_kernel_comp_spv.h"
+#include "bvh_walk_kernel_comp_spv.h"
+#include "gpu/GpuScene.h"
 #include "reference/CpuRenderer.h"
 #include "scene/Parser.h"
 #include "scene/Transform.h"
@@ -199,6 +201,92 @@ Ceiling measureCeiling(vk::Context& context, int runs, bool quick) {
     return c;
 }
 
+
+// The BVH walk's floor on one scene (shaders/bvh_walk_kernel.comp): its
+// camera rays and their shadow rays walked with nothing else, beside the
+// renderer casting the same rays (depth 0, no cut-off) at the same size.
+// What the renderer costs above it is its own; what the floor costs is the
+// walk's on this device.
+struct WalkFloor {
+    std::string scene;
+    int size = 0;
+    double floorMs = 0.0, renderMs = 0.0;         // median dispatch times
+    std::uint64_t floorRays = 0, renderRays = 0;  // camera and shadow rays each cast
+};
+
+std::optional<WalkFloor> measureWalkFloor(vk::Context& context, const Scene& scene, const std::string& name,
+                                          const RenderRequest& base, int runs) {
+    RenderRequest request = base;
+    request.supersample = 1;  // the kernel casts each pixel's centre
+    request.trace.maxDepth = 0;
+    request.trace.minWeight = 0.0;
+    request.trace.tolerance = 0.0;
+    const gpu::GpuScene layout = gpu::buildGpuScene(scene, request.camera);
+    if (!layout.usesBvh()) return std::nullopt;
+    WalkFloor w;
+    w.scene = name;
+    w.size = request.width;
+    gpu::FrameParams frame = gpu::makeFrameParams(scene, layout, request);
+    // Storage buffers may not be empty: a scene without ellipsoids or lights
+    // binds one unused element.
+    const std::vector<gpu::Ellipsoid> ellipsoids =
+        layout.ellipsoids.empty() ? std::vector<gpu::Ellipsoid>(1) : layout.ellipsoids;
+    const std::vector<gpu::Light> lights = layout.lights.empty() ? std::vector<gpu::Light>(1) : layout.lights;
+    const std::uint32_t pixels = std::uint32_t(request.width) * std::uint32_t(request.height);
+    constexpr VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+    std::vector<vk::Buffer> buffers;
+    auto release = [&] {
+        for (vk::Buffer& b : buffers) context.destroy(b);
+    };
+    try {
+        vk::Buffer nodes = context.createBufferWithData(layout.nodes.data(), layout.nodes.size() * sizeof(gpu::BvhNode),
+                                                        VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT);
+        buffers.push_back(nodes);
+        const VkDeviceAddress address = context.deviceAddress(nodes);
+        frame.bvhAddressLow = static_cast<std::uint32_t>(address);
+        frame.bvhAddressHigh = static_cast<std::uint32_t>(address >> 32);
+        buffers.push_back(context.createBufferWithData(&frame, sizeof frame, storage));
+        buffers.push_back(context.createBufferWithData(layout.spheres.data(), layout.spheres.size() * sizeof(gpu::Sphere), storage));
+        buffers.push_back(context.createBufferWithData(ellipsoids.data(), ellipsoids.size() * sizeof(gpu::Ellipsoid), storage));
+        buffers.push_back(context.createBufferWithData(lights.data(), lights.size() * sizeof(gpu::Light), storage));
+        buffers.push_back(context.createBuffer(VkDeviceSize(pixels) * 4 * sizeof(std::uint32_t), storage,
+                                               vk::Context::Memory::HostCached));
+        const auto stackSize = std::uint32_t(layout.bvhStackSize());
+        vk::ComputeKernel kernel(context, snell_bvh_walk_kernel_comp_spv, sizeof snell_bvh_walk_kernel_comp_spv, 5,
+                                 0, {stackSize, stackSize <= SNELL_REGISTER_STACK_LIMIT ? 1u : 0u});
+        std::vector<const vk::Buffer*> bound;  // all but the nodes
+        for (std::size_t k = 1; k < buffers.size(); ++k) bound.push_back(&buffers[k]);
+        const std::uint32_t groups = (pixels + SNELL_KERNEL_GROUP_SIZE - 1) / SNELL_KERNEL_GROUP_SIZE;
+        kernel.run(bound, nullptr, groups);  // warm-up (llvmpipe compiles here)
+        std::vector<double> ms;
+        for (int r = 0; r < runs; ++r) ms.push_back(kernel.run(bound, nullptr, groups));
+        w.floorMs = stats(ms).median;
+        const auto* results = static_cast<const std::uint32_t*>(buffers.back().mapped);
+        w.floorRays = pixels;
+        for (std::uint32_t p = 0; p < pixels; ++p) w.floorRays += results[4 * p + 1];
+    } catch (...) {
+        release();
+        throw;
+    }
+    release();
+    ComputeRenderer renderer(context, scene, request.camera);
+    w.renderRays = renderer.render(request, true).rays.total();
+    std::vector<double> ms;
+    for (int r = 0; r < runs; ++r) ms.push_back(renderer.render(request, false).renderMs);
+    w.renderMs = stats(ms).median;
+    return w;
+}
+
+std::string describe(const WalkFloor& w) {
+    const double floorRate = double(w.floorRays) / (w.floorMs * 1e-3);
+    const double renderRate = double(w.renderRays) / (w.renderMs * 1e-3);
+    std::ostringstream s;
+    s << "walk floor at " << w.size << "x" << w.size << ", depth 0: kernel " << number(w.floorMs) << " ms ("
+      << number(floorRate * 1e-6) << " Mrays/s), renderer " << number(w.renderMs) << " ms ("
+      << number(renderRate * 1e-6) << " Mrays/s, " << number(w.renderMs / w.floorMs) << "x the floor)";
+    if (w.floorRays != w.renderRays) s << "; rays " << w.floorRays << " against the renderer's " << w.renderRays;
+    return s.str();
+}
 
 std::vector<Setting> settingsFor(const Scene& scene, bool quick, bool fp64) {
     std::vector<Setting> s;
@@ -654,6 +742,7 @@ struct Collected {
     std::vector<Price> prices;
     std::vector<Peer> peers;
     std::vector<Scaling> scaling;
+    std::vector<WalkFloor> walkFloors;
     std::map<std::string, double> referenceMs, cpuDefaultMs;
 };
 
@@ -778,6 +867,20 @@ void benchScene(vk::Context& context, const BenchOptions& o, const SceneFile& fi
     log << "  " << describe(out.prices.back()) << "\n";
 
     if (file.group == "bench") out.peers.push_back(measurePeer(context, o, file, scene, cpu, base, runs, log));
+
+    // The walk's floor at the bench's size and, on the shared bench scenes,
+    // at the peers' size.
+    std::vector<int> floorSizes{size};
+    if (file.group == "bench" && !o.quick && scene.imageSize != size) floorSizes.push_back(scene.imageSize);
+    for (int floorSize : floorSizes) {
+        RenderRequest request = base;
+        request.width = request.height = floorSize;
+        request.camera = Camera::fromSpec(floorSize, scene.halfWidth);
+        if (const std::optional<WalkFloor> w = measureWalkFloor(context, scene, name, request, runs)) {
+            log << "  " << describe(*w) << "\n";
+            out.walkFloors.push_back(*w);
+        }
+    }
 }
 
 // Render time against sphere count at 512² (quick: 64², up to 10^4 spheres).
@@ -934,6 +1037,14 @@ void writeJson(const fs::path& path, const Collected& c, const Ceiling& ceiling,
              << ", \"povray_trace_ms\": " << (p.povTraceMs ? number(*p.povTraceMs) : "null")
              << ", \"povray_command_ms\": " << (p.povCommandMs ? number(*p.povCommandMs) : "null")
              << ", \"note\": " << jsonString(p.povNote) << "}" << (i + 1 < c.peers.size() ? "," : "") << "\n";
+    }
+    json << "  ],\n  \"walk_floors\": [\n";
+    for (std::size_t i = 0; i < c.walkFloors.size(); ++i) {
+        const WalkFloor& w = c.walkFloors[i];
+        json << "    {\"scene\": " << jsonString(w.scene) << ", \"size\": " << w.size
+             << ", \"floor_kernel_ms\": " << number(w.floorMs) << ", \"floor_kernel_rays\": " << w.floorRays
+             << ", \"render_depth0_ms\": " << number(w.renderMs) << ", \"render_depth0_rays\": " << w.renderRays
+             << "}" << (i + 1 < c.walkFloors.size() ? "," : "") << "\n";
     }
     json << "  ],\n  \"scaling\": [\n";
     for (std::size_t i = 0; i < c.scaling.size(); ++i) {

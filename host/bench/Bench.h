@@ -4,7 +4,8 @@
 // after a warm-up), measures the error against the converged CPU reference,
 // and records the peers of the same run: the CPU reference itself (converged,
 // and at the GPU's default settings), POV-Ray 3.7 on the shared bench scenes,
-// the device's ray–sphere ceiling and store-only floor, and the render time
+// the device's ray–sphere ceiling and store-only floor, the BVH walk's floor
+// on each BVH scene (its rays walked alone, beside the renderer), and the render time
 // against sphere count. It prices the default settings per scene: their
 // dispatch time over that of the fastest fixed tree (tolerance 0: a weight
 // cut-off 4^-k, or a depth cap without one) whose measured error is no worse,

@@ -98,10 +98,12 @@ ComputeRenderer::ComputeRenderer(vk::Context& context, const Scene& scene, const
                            (traversal == gpu::Traversal::Auto && !context.isCpuDevice()));
     const auto start = Clock::now();
     layout_ = gpu::buildGpuScene(scene, camera, precision, bvh, rayQuery);
-    // Mesa 25's lavapipe calls a function for each texel fetch; its loads of
-    // a storage buffer are faster in the BVH walk, and slower on Mesa 22.3
-    // (docs/performance.md, "The BVH as a storage buffer").
-    bvhWords_ = context.isLlvmpipe() && context.mesaMajor() >= 25 && bvhFitsWords();
+    // Mesa 25's lavapipe calls a function for each texel fetch; its loads
+    // from the nodes' device address are faster in the BVH walk (and faster
+    // than its bounds-checked storage-buffer loads), where Mesa 22.3 inlines
+    // its fetches (docs/performance.md, "The BVH as a storage buffer", "The
+    // walk's floor").
+    bvhWords_ = context.isLlvmpipe() && context.mesaMajor() >= 25;
     // A CPU device runs a SIMD row's stores at per-lane indices lane by lane;
     // a GPU keeps such a stack in its local memory (unmeasured there: left
     // as it was). docs/performance.md, "The walk's stack in registers".
@@ -140,9 +142,9 @@ ComputeRenderer::ComputeRenderer(vk::Context& context, const Scene& scene, const
         upload(SNELL_BINDING_ELLIPSOIDS, layout_.ellipsoids, rgba, "ellipsoids");
         upload(SNELL_BINDING_MATERIALS, layout_.materials, rgba, "materials");
         upload(SNELL_BINDING_LIGHTS, layout_.lights, rgba, "lights");
-        // Read as texels, or as a storage buffer (SNELL_BINDING_BVH_WORDS).
+        // Read as texels, or through its device address (FrameParams.bvhAddress).
         upload(SNELL_BINDING_BVH, layout_.nodes, VK_FORMAT_R32G32B32A32_UINT, "BVH nodes",
-               VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+               VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT);
         if (!layout_.sphereBoxes.empty())
             sphereBoxes_ = std::make_unique<vk::BoxAccelerationStructure>(
                 context_, layout_.sphereBoxes.data(), static_cast<std::uint32_t>(layout_.sphereBoxes.size()));
@@ -166,10 +168,6 @@ ComputeRenderer::ComputeRenderer(vk::Context& context, const Scene& scene, const
         throw;
     }
     uploadMs_ = msSince(start);
-}
-
-bool ComputeRenderer::bvhFitsWords() const {
-    return layout_.nodes.size() * sizeof(layout_.nodes[0]) <= context_.properties().limits.maxStorageBufferRange;
 }
 
 bool ComputeRenderer::stackInRegisters() const {
@@ -346,7 +344,6 @@ void ComputeRenderer::createPipeline(const Specialisation& values, Pipeline& p) 
     p.bindings.clear();
     for (std::uint32_t i = 0; i < (wide ? SNELL_BINDING_COUNT : SNELL_BINDING_COUNT_FP32); ++i) p.bindings.push_back(i);
     if (sphereBoxes_) p.bindings.push_back(SNELL_BINDING_ACCELERATION);
-    p.bindings.push_back(SNELL_BINDING_BVH_WORDS);
     std::vector<VkDescriptorSetLayoutBinding> bindings(p.bindings.size());
     for (std::size_t k = 0; k < bindings.size(); ++k) {
         bindings[k].binding = p.bindings[k];
@@ -643,7 +640,10 @@ ComputeRenderer::Pipeline& ComputeRenderer::ensurePipeline(const Specialisation&
 void ComputeRenderer::ensureBuffers(Pipeline& p, const RenderRequest& request, const TilePlan& plan) {
     const bool wide = layout_.precision == gpu::Precision::Fp64;
     gpu::FrameParams frameLow{};
-    const gpu::FrameParams frame = gpu::makeFrameParams(scene_, layout_, request, &frameLow);
+    gpu::FrameParams frame = gpu::makeFrameParams(scene_, layout_, request, &frameLow);
+    const VkDeviceAddress nodes = context_.deviceAddress(sceneBuffers_[SNELL_BINDING_BVH]);
+    frame.bvhAddressLow = static_cast<std::uint32_t>(nodes);
+    frame.bvhAddressHigh = static_cast<std::uint32_t>(nodes >> 32);
     context_.destroy(p.frame);
     context_.destroy(p.frameLow);
     p.frame = context_.createBufferWithData(&frame, sizeof frame, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
@@ -700,14 +700,6 @@ void ComputeRenderer::ensureBuffers(Pipeline& p, const RenderRequest& request, c
             accelerationInfo.accelerationStructureCount = 1;
             accelerationInfo.pAccelerationStructures = &sphereBoxes_->top();
             writes[k].pNext = &accelerationInfo;
-        } else if (i == SNELL_BINDING_BVH_WORDS) {
-            // The texels' buffer again. A BVH larger than a storage buffer may
-            // be is never read through this view (bvhFitsWords), but the
-            // descriptor must still be valid.
-            const vk::Buffer& nodes = sceneBuffers_[SNELL_BINDING_BVH];
-            bufferInfo[i] = {nodes.buffer, 0,
-                             std::min<VkDeviceSize>(nodes.size, context_.properties().limits.maxStorageBufferRange)};
-            writes[k].pBufferInfo = &bufferInfo[i];
         } else {
             if (!buffers[i]) buffers[i] = &sceneBuffers_[i];
             bufferInfo[i] = {buffers[i]->buffer, 0, VK_WHOLE_SIZE};

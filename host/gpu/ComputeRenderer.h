@@ -98,10 +98,10 @@ public:
     // (vulkan/SpecialisedModule.h). The image is the same either way.
     void foldSpecialisation(bool fold) { foldSpecialisation_ = fold; }
     bool kernelFolded() const;  // the last render's kernel had its specialisation folded in
-    // Testing: whether the BVH walk reads the nodes as a storage buffer or as
-    // texels (by default as the driver reads faster, and texels where the
-    // nodes exceed the device's storage-buffer range). The image is the same.
-    void readBvhWords(bool words) { bvhWords_ = words && bvhFitsWords(); }
+    // Testing: whether the BVH walk reads the nodes through their device
+    // address or as texels (by default as the driver reads faster). The
+    // image is the same.
+    void readBvhWords(bool words) { bvhWords_ = words; }
     bool readsBvhWords() const { return bvhWords_; }
     // Testing: whether the walk's stack may live in registers where it fits
     // (SNELL_REGISTER_STACK_LIMIT; by default on CPU devices), else an array at
@@ -149,7 +149,6 @@ private:
                 const std::function<void(VkCommandBuffer)>& record);
     void destroyBuffers();
     bool spheresInBlock() const;  // every sphere in the uniform block (shared_layout.h)
-    bool bvhFitsWords() const;    // the BVH's nodes fit in one storage-buffer descriptor
 
     vk::Context& context_;
     const Scene& scene_;

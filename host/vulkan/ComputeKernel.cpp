@@ -5,7 +5,8 @@
 namespace snell::vk {
 
 ComputeKernel::ComputeKernel(Context& context, const std::uint32_t* spirv, std::size_t spirvBytes,
-                             std::uint32_t storageBuffers, std::uint32_t pushConstantBytes)
+                             std::uint32_t storageBuffers, std::uint32_t pushConstantBytes,
+                             const std::vector<std::uint32_t>& specialisation)
     : context_(context), storageBuffers_(storageBuffers), pushConstantBytes_(pushConstantBytes) {
     VkDevice device = context.device();
     try {
@@ -32,6 +33,12 @@ ComputeKernel::ComputeKernel(Context& context, const std::uint32_t* spirv, std::
         pipelineInfo.stage.stage = VK_SHADER_STAGE_COMPUTE_BIT;
         pipelineInfo.stage.module = module_;
         pipelineInfo.stage.pName = "main";
+        std::vector<VkSpecializationMapEntry> entries(specialisation.size());
+        for (std::uint32_t i = 0; i < entries.size(); ++i)
+            entries[i] = {i, std::uint32_t(i * sizeof(std::uint32_t)), sizeof(std::uint32_t)};
+        VkSpecializationInfo specialisationInfo{std::uint32_t(entries.size()), entries.data(),
+                                                specialisation.size() * sizeof(std::uint32_t), specialisation.data()};
+        if (!specialisation.empty()) pipelineInfo.stage.pSpecializationInfo = &specialisationInfo;
         pipelineInfo.layout = layout_;
         check(vkCreateComputePipelines(device, VK_NULL_HANDLE, 1, &pipelineInfo, nullptr, &pipeline_),
               "vkCreateComputePipelines");

@@ -13,8 +13,10 @@ namespace snell::vk {
 
 class ComputeKernel {
 public:
+    // specialisation: the values of constant_id 0, 1, … (32-bit each: uint,
+    // or bool as 0/1).
     ComputeKernel(Context& context, const std::uint32_t* spirv, std::size_t spirvBytes, std::uint32_t storageBuffers,
-                  std::uint32_t pushConstantBytes = 0);
+                  std::uint32_t pushConstantBytes = 0, const std::vector<std::uint32_t>& specialisation = {});
     ~ComputeKernel();
     ComputeKernel(const ComputeKernel&) = delete;
     ComputeKernel& operator=(const ComputeKernel&) = delete;

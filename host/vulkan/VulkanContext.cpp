@@ -144,6 +144,15 @@ DeviceReport examine(VkPhysicalDevice device, int index, std::uint32_t& family,
         report.reason = "lacks basic, vote and arithmetic subgroup operations in compute shaders";
         return report;
     }
+    VkPhysicalDeviceVulkan12Features v12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
+    VkPhysicalDeviceFeatures2 features{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &v12};
+    vkGetPhysicalDeviceFeatures2(device, &features);
+    if (!v12.bufferDeviceAddress) {
+        // The kernel reads the BVH's nodes through their address on some
+        // drivers, and so declares the capability on all.
+        report.reason = "lacks the bufferDeviceAddress feature (Vulkan 1.2, required from 1.3)";
+        return report;
+    }
     VkFormatProperties format;
     vkGetPhysicalDeviceFormatProperties(device, VK_FORMAT_R32G32B32A32_SFLOAT, &format);
     if (!(format.optimalTilingFeatures & VK_FORMAT_FEATURE_STORAGE_IMAGE_BIT)) {
@@ -400,7 +409,10 @@ void Context::createDevice(const std::vector<std::string>& extensions, RayQuerie
     VkPhysicalDeviceRayQueryFeaturesKHR rayQuery{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_QUERY_FEATURES_KHR};
     VkPhysicalDeviceAccelerationStructureFeaturesKHR accel{
         VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR, &rayQuery};
-    VkPhysicalDeviceVulkan12Features v12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES, &accel};
+    // Every device snell uses has buffer device addresses (examine).
+    VkPhysicalDeviceVulkan12Features v12{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_VULKAN_1_2_FEATURES};
+    v12.bufferDeviceAddress = VK_TRUE;
+    enabled.pNext = &v12;
     if (rayQueries == RayQueries::Off) {
         rayQueryAbsence_ = "ray queries were not asked for";
     } else if (rayQueries == RayQueries::OnGpus && isCpuDevice()) {
@@ -409,8 +421,7 @@ void Context::createDevice(const std::vector<std::string>& extensions, RayQuerie
         rayQueries_ = true;
         rayQuery.rayQuery = VK_TRUE;
         accel.accelerationStructure = VK_TRUE;
-        v12.bufferDeviceAddress = VK_TRUE;
-        enabled.pNext = &v12;
+        v12.pNext = &accel;
     }
     std::uint32_t extCount = 0;
     vkEnumerateDeviceExtensionProperties(physical_, nullptr, &extCount, nullptr);
