@@ -62,7 +62,8 @@ uint walk(vec3 origin, vec3 dir, uint fromSphere, uint start, bool anyHit, inout
 }
 
 void main() {
-    uint pixel = gl_GlobalInvocationID.x;
+    uint pixel = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * SNELL_KERNEL_GROUP_SIZE +
+                 gl_LocalInvocationID.x;
     if (pixel >= frame.imageWidth * frame.imageHeight) return;
     vec2 q = vec2(pixel % frame.imageWidth, pixel / frame.imageWidth) + 0.5;
     vec3 dir = normalize(frame.cornerDir.xyz + q.x * frame.pixelRight.xyz + q.y * frame.pixelDown.xyz);

@@ -20,6 +20,7 @@ for f in bench.csv bench.json; do [ -s "$out/$f" ] || { echo "FAIL: no $f"; exit
 [ "$(head -c 4 "$out/bench.png" | od -An -c | tr -d ' ')" = "211PNG" ] || { echo "FAIL: no plot"; exit 1; }
 grep -q "^| bench/simple" "$out/tables.md" || { echo "FAIL: no table row for bench/simple"; exit 1; }
 grep -q "^| scene | default ms | price of the default" "$out/tables.md" || { echo "FAIL: no price table"; exit 1; }
+grep -q "^| BVH scene (depth 0) | size | walk's floor ms" "$out/tables.md" || { echo "FAIL: no walk floor table"; exit 1; }
 grep -q "^Price of the default: geometric mean" "$out/tables.md" || { echo "FAIL: no price summary"; exit 1; }
 grep -q "^price of the default: geometric mean" "$out/log" || { echo "FAIL: no price summary in the log"; exit 1; }
 "$PYTHON" - "$out" <<'PY'
@@ -55,6 +56,11 @@ for need in ("scenes/grid", "bench/grid"):
     if need not in floors: fail.append(f"no walk floor for {need}")
 for w in d.get("walk_floors", []):
     if not (w["floor_kernel_ms"] > 0 and w["render_depth0_ms"] > 0): fail.append(f"walk floor {w}")
+    # Both grids show background and cast shadows on each other: some
+    # camera rays miss, some shadow rays are blocked, not all.
+    shadow = w["floor_kernel_rays"] - w["size"] ** 2
+    if not 0 < w["floor_kernel_hits"] < w["size"] ** 2: fail.append(f"walk floor {w['scene']}: hits {w}")
+    if not 0 < w["floor_kernel_blocked"] < shadow: fail.append(f"walk floor {w['scene']}: blocked {w}")
     if abs(w["floor_kernel_rays"] - w["render_depth0_rays"]) > 1e-3 * w["render_depth0_rays"]:
         fail.append(f"walk floor {w['scene']}: {w['floor_kernel_rays']} rays, the renderer {w['render_depth0_rays']}")
 if [s["spheres"] for s in d["scaling"]] != [10, 100, 1000, 10000]: fail.append("scaling counts")

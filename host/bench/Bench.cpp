@@ -212,6 +212,7 @@ struct WalkFloor {
     int size = 0;
     double floorMs = 0.0, renderMs = 0.0;         // median dispatch times
     std::uint64_t floorRays = 0, renderRays = 0;  // camera and shadow rays each cast
+    std::uint64_t floorHits = 0, floorBlocked = 0;  // the kernel's camera rays that hit, shadow rays blocked
 };
 
 std::optional<WalkFloor> measureWalkFloor(vk::Context& context, const Scene& scene, const std::string& name,
@@ -235,6 +236,7 @@ std::optional<WalkFloor> measureWalkFloor(vk::Context& context, const Scene& sce
     const std::uint32_t pixels = std::uint32_t(request.width) * std::uint32_t(request.height);
     constexpr VkBufferUsageFlags storage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
     std::vector<vk::Buffer> buffers;
+    buffers.reserve(6);  // push_back cannot throw and lose a buffer
     auto release = [&] {
         for (vk::Buffer& b : buffers) context.destroy(b);
     };
@@ -256,14 +258,22 @@ std::optional<WalkFloor> measureWalkFloor(vk::Context& context, const Scene& sce
                                  0, {stackSize, stackSize <= SNELL_REGISTER_STACK_LIMIT ? 1u : 0u});
         std::vector<const vk::Buffer*> bound;  // all but the nodes
         for (std::size_t k = 1; k < buffers.size(); ++k) bound.push_back(&buffers[k]);
+        // Rows of at most 32768 workgroups (a device may allow no more than
+        // 65535 in one dimension).
         const std::uint32_t groups = (pixels + SNELL_KERNEL_GROUP_SIZE - 1) / SNELL_KERNEL_GROUP_SIZE;
-        kernel.run(bound, nullptr, groups);  // warm-up (llvmpipe compiles here)
+        const std::uint32_t groupsX = std::min(groups, 32768u);
+        const std::uint32_t groupsY = (groups + groupsX - 1) / groupsX;
+        kernel.run(bound, nullptr, groupsX, groupsY);  // warm-up (llvmpipe compiles here)
         std::vector<double> ms;
-        for (int r = 0; r < runs; ++r) ms.push_back(kernel.run(bound, nullptr, groups));
+        for (int r = 0; r < runs; ++r) ms.push_back(kernel.run(bound, nullptr, groupsX, groupsY));
         w.floorMs = stats(ms).median;
         const auto* results = static_cast<const std::uint32_t*>(buffers.back().mapped);
         w.floorRays = pixels;
-        for (std::uint32_t p = 0; p < pixels; ++p) w.floorRays += results[4 * p + 1];
+        for (std::uint32_t p = 0; p < pixels; ++p) {
+            w.floorHits += results[4 * p] != 0xffffffffu ? 1 : 0;
+            w.floorRays += results[4 * p + 1];
+            w.floorBlocked += results[4 * p + 2];
+        }
     } catch (...) {
         release();
         throw;
@@ -1043,6 +1053,7 @@ void writeJson(const fs::path& path, const Collected& c, const Ceiling& ceiling,
         const WalkFloor& w = c.walkFloors[i];
         json << "    {\"scene\": " << jsonString(w.scene) << ", \"size\": " << w.size
              << ", \"floor_kernel_ms\": " << number(w.floorMs) << ", \"floor_kernel_rays\": " << w.floorRays
+             << ", \"floor_kernel_hits\": " << w.floorHits << ", \"floor_kernel_blocked\": " << w.floorBlocked
              << ", \"render_depth0_ms\": " << number(w.renderMs) << ", \"render_depth0_rays\": " << w.renderRays
              << "}" << (i + 1 < c.walkFloors.size() ? "," : "") << "\n";
     }
