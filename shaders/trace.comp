@@ -159,13 +159,19 @@ uint countedRays[SNELL_RAY_COUNTER_COUNT];
 
 rvec4 preloadedAnchor[SNELL_MAX_UNROLLED_SPHERES];
 rvec4 preloadedNormal[SNELL_MAX_UNROLLED_SPHERES];
+// An unrolled ellipsoid's map (ELLIPSOID_MASK), read once per dispatch: its
+// three texels fetched at every test (on lavapipe a call of ~64 instructions
+// each, whatever the index) cost bench/simple a quarter of its dispatch.
+rmat4 preloadedEllipsoid[SNELL_MAX_UNROLLED_SPHERES];
 real intersectSphere(uint index, rvec3 origin, real originLength, rvec3 dir, uint fromSphere, uint start) {
     uint mode = index == fromSphere ? start : ELSEWHERE;
     rvec4 anchor = SPHERE_COUNT > 0u ? preloadedAnchor[index] : sphereAnchor(index);
     rvec4 normal = SPHERE_COUNT > 0u ? preloadedNormal[index] : sphereNormal(index);
     bool ellipsoid = SPHERE_COUNT > 0u ? ((ELLIPSOID_MASK >> index) & 1u) != 0u : anchor.w < 0.0;
-    if (HAS_ELLIPSOIDS && ellipsoid)
-        return intersectEllipsoid(ellipsoidMatrix(uint(-anchor.w) - 1u), normal.w, origin, originLength, dir, mode);
+    if (HAS_ELLIPSOIDS && ellipsoid) {
+        rmat4 objectFromWorld = SPHERE_COUNT > 0u ? preloadedEllipsoid[index] : ellipsoidMatrix(uint(-anchor.w) - 1u);
+        return intersectEllipsoid(objectFromWorld, normal.w, origin, originLength, dir, mode);
+    }
     return intersectTrueSphere(anchor, normal, origin, originLength, dir, mode);
 }
 
@@ -1046,6 +1052,8 @@ void beginDispatch() {
     [[unroll]] for (uint i = 0u; i < SPHERE_COUNT; ++i) {
         preloadedAnchor[i] = sphereAnchor(i);
         preloadedNormal[i] = sphereNormal(i);
+        if (HAS_ELLIPSOIDS && ((ELLIPSOID_MASK >> i) & 1u) != 0u)
+            preloadedEllipsoid[i] = ellipsoidMatrix(uint(-preloadedAnchor[i].w) - 1u);
     }
     // Mesa 22.3's lavapipe specialises a shader on values it reads from
     // uniforms with constant offsets where it judges that worthwhile
