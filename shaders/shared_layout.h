@@ -95,7 +95,8 @@ using uint = std::uint32_t;
 #define SNELL_SPEC_BVH_WORDS 19    // the walk reads the BVH's nodes through their address (FrameParams.bvhAddress)
 #define SNELL_SPEC_STACK_IN_REGISTERS 20  // the walk's stack in registers (trace.comp, pushEntry)
 #define SNELL_SPEC_SHARE_SHADOW_RAYS 21  // a subgroup's shadow rays walked by all its lanes (trace.comp, shadeLightsShared)
-#define SNELL_SPEC_COUNT 22
+#define SNELL_SPEC_LIGHTS_IN_FRAME 22  // the lights are read from FrameParams.lights
+#define SNELL_SPEC_COUNT 23
 // The deepest walk stack kept in registers (entries); a deeper one is an array
 // at a per-lane index.
 #define SNELL_REGISTER_STACK_LIMIT 32
@@ -194,6 +195,7 @@ struct Light {
     vec4 position;  // camera-relative, w unused
     vec4 colour;    // rgb, w unused
 };
+#define SNELL_FRAME_LIGHTS 16
 
 // A BVH node of up to four children (read as RGBA32UI, SNELL_BVH_NODE_TEXELS
 // texels a node): their boxes axis by axis, lane k of each corner being child
@@ -307,6 +309,11 @@ struct FrameParams {
     uint pad0;
     uint pad1;
     uint pad2;
+    // A scene of at most SNELL_FRAME_LIGHTS lights has them here again
+    // (SNELL_SPEC_LIGHTS_IN_FRAME): the lights' loop reads light j at one index
+    // for the whole SIMD row, a scalar load, where a texel fetch is a call of
+    // ~64 instructions on lavapipe whatever the index.
+    Light lights[SNELL_FRAME_LIGHTS];
 };
 
 // Interleaved tiles (ComputeRenderer) take the image's columns in runs of a

@@ -141,8 +141,15 @@ rmat4 ellipsoidMatrix(uint e) {
     return transpose(rmat4(FETCH(ellipsoidTexels, 3u * e), FETCH(ellipsoidTexels, 3u * e + 1u),
                            FETCH(ellipsoidTexels, 3u * e + 2u), rvec4(0.0, 0.0, 0.0, 1.0)));
 }
-rvec3 lightPosition(uint j) { return FETCH(lightTexels, 2u * j).xyz; }
-vec3 lightColour(uint j) { return texelFetch(lightTexels, int(2u * j + 1u)).rgb; }
+layout(constant_id = SNELL_SPEC_LIGHTS_IN_FRAME) const bool LIGHTS_IN_FRAME = false;
+rvec3 lightPosition(uint j) {
+    if (LIGHTS_IN_FRAME) return WIDE(frame.lights[j].position, frameLow.lights[j].position).xyz;
+    return FETCH(lightTexels, 2u * j).xyz;
+}
+vec3 lightColour(uint j) {
+    if (LIGHTS_IN_FRAME) return frame.lights[j].colour.rgb;
+    return texelFetch(lightTexels, int(2u * j + 1u)).rgb;
+}
 uint sphereMaterial(uint i) { return texelFetch(sphereMaterialTexels, int(i)).r; }
 vec4 materialKd(uint m) { return texelFetch(materialTexels, int(3u * m)); }
 vec4 materialKs(uint m) { return texelFetch(materialTexels, int(3u * m + 1u)); }

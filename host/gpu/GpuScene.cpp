@@ -249,6 +249,11 @@ FrameParams makeFrameParams(const snell::Scene& scene, const GpuScene& gpuScene,
     splitVec4(camera.cornerDir, 0.0, f.cornerDir, low.cornerDir);
     splitVec4(camera.pixelRight, 0.0, f.pixelRight, low.pixelRight);
     splitVec4(camera.pixelDown, 0.0, f.pixelDown, low.pixelDown);
+    // A few lights again in the frame (FrameParams.lights), with their low parts.
+    if (gpuScene.lights.size() <= SNELL_FRAME_LIGHTS) {
+        std::copy(gpuScene.lights.begin(), gpuScene.lights.end(), f.lights);
+        std::copy(gpuScene.lightLows.begin(), gpuScene.lightLows.end(), low.lights);
+    }
     if (lowParts) *lowParts = low;
     f.background = toVec4(scene.background, 0.0);
     f.ambient = toVec4(scene.ambient, 0.0);
