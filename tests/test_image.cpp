@@ -357,6 +357,29 @@ TEST_F(ImageFiles, StreamedRowsMatchWholeImage) {
     }
 }
 
+// A PNG large enough to be deflated in several segments side by side reads
+// back as its bytes, and its file does not depend on the bands.
+TEST_F(ImageFiles, PngOfManySegmentsReadsBackAndIgnoresBands) {
+    Image image(256, 700);  // 769-byte scanlines: 538 KB, four segments
+    for (std::size_t i = 0; i < image.rgb.size(); ++i) image.rgb[i] = float((i * 7919) % 1000) / 900.0f - 0.05f;
+    snell::writeImage(path("whole.png"), image);
+    auto writer = snell::ImageWriter::open(path("bands.png"), 256, 700);
+    int row = 0;
+    for (int band : {1, 170, 3, 400, 126}) {
+        writer->writeRows(image.pixel(0, row), band);
+        row += band;
+    }
+    writer->commit();
+    EXPECT_EQ(slurp(path("bands.png")), slurp(path("whole.png")));
+    const Image back = snell::readImage(path("whole.png"));
+    ASSERT_EQ(back.width, 256);
+    ASSERT_EQ(back.height, 700);
+    std::size_t wrong = 0;
+    for (std::size_t i = 0; i < image.rgb.size(); ++i)
+        wrong += float(snell::toByte(image.rgb[i])) / 255.0f != back.rgb[i];
+    EXPECT_EQ(wrong, 0u);
+}
+
 // An abandoned writer (an error or Ctrl-C mid-render) leaves no file at all.
 TEST_F(ImageFiles, UncommittedWriterLeavesNothing) {
     {

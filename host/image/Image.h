@@ -21,10 +21,12 @@ struct Image {
 
 // SPEC §6: clamp to [0, 1], then round(255 c) with halves rounded up.
 // NaN maps to 0 here; metrics count NaN separately.
+// Without branches, so that loops over pixels vectorise: 255 c + ½ >= ½ is
+// positive, where truncation is floor.
 inline std::uint8_t toByte(float c) {
-    if (!(c > 0.0f)) return 0;
-    if (c >= 1.0f) return 255;
-    return static_cast<std::uint8_t>(std::floor(static_cast<double>(c) * 255.0 + 0.5));
+    float clamped = c > 0.0f ? c : 0.0f;
+    clamped = clamped < 1.0f ? clamped : 1.0f;
+    return static_cast<std::uint8_t>(static_cast<int>(static_cast<double>(clamped) * 255.0 + 0.5));
 }
 
 }  // namespace snell
