@@ -44,13 +44,15 @@ using uint = std::uint32_t;
 #define SNELL_BINDING_MEDIA_STACK 4
 // Uniform buffer: the render's parameters.
 #define SNELL_BINDING_FRAME 5
-// Uniform texel buffers: the scene (RGBA32F unless said).
+// Uniform texel buffers: the scene, every view RGBA32UI, floats by their bits
+// (lavapipe compiles its texel-fetch functions for each new format a view
+// has, about a millisecond each: one format for all of them saves two).
 #define SNELL_BINDING_SPHERES 6           // Sphere
-#define SNELL_BINDING_SPHERE_MATERIALS 7  // R32UI: the material of each sphere
+#define SNELL_BINDING_SPHERE_MATERIALS 7  // the material of each sphere, four a texel
 #define SNELL_BINDING_ELLIPSOIDS 8        // Ellipsoid
 #define SNELL_BINDING_MATERIALS 9         // Material
 #define SNELL_BINDING_LIGHTS 10           // Light
-#define SNELL_BINDING_BVH 11              // RGBA32UI: BvhNode
+#define SNELL_BINDING_BVH 11              // BvhNode
 // Uniform buffer: the spheres of a scene small enough to need no BVH
 // (SphereBlock; for fp64 followed by their low parts), which the shader's
 // loops read at one index for the whole SIMD row (a scalar load).

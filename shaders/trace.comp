@@ -89,12 +89,16 @@ layout(set = 0, binding = SNELL_BINDING_RAY_STACK, std430) buffer RayStackBlock 
 layout(set = 0, binding = SNELL_BINDING_MEDIA_STACK, std430) buffer MediaStackBlock { uint mediaStack[]; };
 layout(set = 0, binding = SNELL_BINDING_FRAME, std140) uniform FrameBlock { FrameParams frame; };
 layout(push_constant) uniform TileBlock { TileParams tile; };
-// The scene: texel buffers, each struct of shared_layout.h a run of texels.
-layout(set = 0, binding = SNELL_BINDING_SPHERES) uniform textureBuffer sphereTexels;
+// Texel i of a scene buffer of floats.
+#define texel(texels, i) uintBitsToFloat(texelFetch(texels, int(i)))
+// The scene: texel buffers, each struct of shared_layout.h a run of texels,
+// all RGBA32UI (floats by their bits: texel), since lavapipe compiles its
+// fetch functions once for each format a view has (shared_layout.h).
+layout(set = 0, binding = SNELL_BINDING_SPHERES) uniform utextureBuffer sphereTexels;
 layout(set = 0, binding = SNELL_BINDING_SPHERE_MATERIALS) uniform utextureBuffer sphereMaterialTexels;
-layout(set = 0, binding = SNELL_BINDING_ELLIPSOIDS) uniform textureBuffer ellipsoidTexels;
-layout(set = 0, binding = SNELL_BINDING_MATERIALS) uniform textureBuffer materialTexels;
-layout(set = 0, binding = SNELL_BINDING_LIGHTS) uniform textureBuffer lightTexels;
+layout(set = 0, binding = SNELL_BINDING_ELLIPSOIDS) uniform utextureBuffer ellipsoidTexels;
+layout(set = 0, binding = SNELL_BINDING_MATERIALS) uniform utextureBuffer materialTexels;
+layout(set = 0, binding = SNELL_BINDING_LIGHTS) uniform utextureBuffer lightTexels;
 layout(set = 0, binding = SNELL_BINDING_BVH) uniform utextureBuffer bvhTexels;
 // The BVH's nodes again, the same buffer read through its device address.
 layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer BvhWords { uvec4 words[]; };
@@ -114,16 +118,16 @@ layout(set = 0, binding = SNELL_BINDING_SPHERE_BLOCK, std140) uniform SphereUnif
 // pair hi + lo: the low parts live in twin buffers of the same layout.
 #ifdef SNELL_FP64
 layout(set = 0, binding = SNELL_BINDING_FRAME_LOW, std140) uniform FrameLowBlock { FrameParams frameLow; };
-layout(set = 0, binding = SNELL_BINDING_SPHERES_LOW) uniform textureBuffer sphereTexelsLow;
-layout(set = 0, binding = SNELL_BINDING_ELLIPSOIDS_LOW) uniform textureBuffer ellipsoidTexelsLow;
-layout(set = 0, binding = SNELL_BINDING_LIGHTS_LOW) uniform textureBuffer lightTexelsLow;
+layout(set = 0, binding = SNELL_BINDING_SPHERES_LOW) uniform utextureBuffer sphereTexelsLow;
+layout(set = 0, binding = SNELL_BINDING_ELLIPSOIDS_LOW) uniform utextureBuffer ellipsoidTexelsLow;
+layout(set = 0, binding = SNELL_BINDING_LIGHTS_LOW) uniform utextureBuffer lightTexelsLow;
 layout(set = 0, binding = SNELL_BINDING_RAY_STACK_LOW, std430) buffer RayStackLowBlock { PendingRay rayStackLow[]; };
 #define WIDE(hi, lo) (dvec4(hi) + dvec4(lo))
 // Texel i of a scene buffer and of its low twin (named ...Low).
-#define FETCH(texels, i) WIDE(texelFetch(texels, int(i)), texelFetch(texels##Low, int(i)))
+#define FETCH(texels, i) WIDE(texel(texels, i), texel(texels##Low, i))
 #else
 #define WIDE(hi, lo) (hi)
-#define FETCH(texels, i) texelFetch(texels, int(i))
+#define FETCH(texels, i) texel(texels, i)
 #endif
 // A small scene's spheres come from a uniform buffer: loops over them read one
 // sphere for the whole SIMD row, a scalar load, cheaper on lavapipe than a
@@ -148,12 +152,17 @@ rvec3 lightPosition(uint j) {
 }
 vec3 lightColour(uint j) {
     if (LIGHTS_IN_FRAME) return frame.lights[j].colour.rgb;
-    return texelFetch(lightTexels, int(2u * j + 1u)).rgb;
+    return texel(lightTexels, 2u * j + 1u).rgb;
 }
-uint sphereMaterial(uint i) { return texelFetch(sphereMaterialTexels, int(i)).r; }
-vec4 materialKd(uint m) { return texelFetch(materialTexels, int(3u * m)); }
-vec4 materialKs(uint m) { return texelFetch(materialTexels, int(3u * m + 1u)); }
-vec4 materialKt(uint m) { return texelFetch(materialTexels, int(3u * m + 2u)); }
+// Four spheres' materials a texel.
+uint sphereMaterial(uint i) {
+    uvec4 four = texelFetch(sphereMaterialTexels, int(i / 4u));
+    uint k = i % 4u;
+    return k == 0u ? four.x : k == 1u ? four.y : k == 2u ? four.z : four.w;
+}
+vec4 materialKd(uint m) { return texel(materialTexels, 3u * m); }
+vec4 materialKs(uint m) { return texel(materialTexels, 3u * m + 1u); }
+vec4 materialKt(uint m) { return texel(materialTexels, 3u * m + 2u); }
 
 const uint NONE = 0xffffffffu;
 

@@ -122,7 +122,7 @@ ComputeRenderer::ComputeRenderer(vk::Context& context, const Scene& scene, const
     auto upload = [&](std::uint32_t binding, const auto& v, VkFormat format, const char* what,
                       VkBufferUsageFlags alsoAs = 0) {
         const VkDeviceSize bytes = v.size() * sizeof(v[0]);
-        const VkDeviceSize texelBytes = format == VK_FORMAT_R32_UINT ? 4 : 16;
+        const VkDeviceSize texelBytes = 16;
         if (bytes / texelBytes > maxTexels)
             throw vk::VulkanError(std::string("the scene's ") + what + " need " + std::to_string(bytes / texelBytes) +
                                   " texels, more than this device's texel-buffer limit of " +
@@ -136,14 +136,18 @@ ComputeRenderer::ComputeRenderer(vk::Context& context, const Scene& scene, const
         check(vkCreateBufferView(context_.device(), &info, nullptr, &sceneViews_[binding]), "vkCreateBufferView");
     };
     try {
-        constexpr VkFormat rgba = VK_FORMAT_R32G32B32A32_SFLOAT;
+        // One format for every view (shared_layout.h): floats go as their bits,
+        // the spheres' materials four a texel.
+        constexpr VkFormat rgba = VK_FORMAT_R32G32B32A32_UINT;
+        std::vector<std::uint32_t> sphereMaterials = layout_.sphereMaterials;
+        sphereMaterials.resize((sphereMaterials.size() + 3) / 4 * 4);
         upload(SNELL_BINDING_SPHERES, layout_.spheres, rgba, "spheres");
-        upload(SNELL_BINDING_SPHERE_MATERIALS, layout_.sphereMaterials, VK_FORMAT_R32_UINT, "spheres");
+        upload(SNELL_BINDING_SPHERE_MATERIALS, sphereMaterials, rgba, "spheres");
         upload(SNELL_BINDING_ELLIPSOIDS, layout_.ellipsoids, rgba, "ellipsoids");
         upload(SNELL_BINDING_MATERIALS, layout_.materials, rgba, "materials");
         upload(SNELL_BINDING_LIGHTS, layout_.lights, rgba, "lights");
         // Read as texels, or through its device address (FrameParams.bvhAddress).
-        upload(SNELL_BINDING_BVH, layout_.nodes, VK_FORMAT_R32G32B32A32_UINT, "BVH nodes",
+        upload(SNELL_BINDING_BVH, layout_.nodes, rgba, "BVH nodes",
                VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT);
         if (!layout_.sphereBoxes.empty())
             sphereBoxes_ = std::make_unique<vk::BoxAccelerationStructure>(
