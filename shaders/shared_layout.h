@@ -11,8 +11,8 @@
 // 3x cheaper than the bounds-checked per-lane loads of a storage buffer
 // (docs/performance.md), and they count elements (2^27 texels on lavapipe), so
 // the documented limit of 4 000 000 spheres fits where 128 MiB of storage
-// buffer does not. Integers that ride in a vec4 are stored as the bits of a
-// uint and read through an RGBA32UI view: no float conversion, exact. The
+// buffer does not. Every view is RGBA32UI: integers are read as they are,
+// floats by their bits (uintBitsToFloat), exact either way. The
 // BVH can also be read through its buffer's device address
 // (FrameParams.bvhAddress, GL_EXT_buffer_reference): Mesa 25's lavapipe calls
 // a function for every texel fetch, which in the walk's seven fetches a node

@@ -14,6 +14,7 @@
 
 #include "image/ImageIO.h"
 #include "metrics/ImageMetrics.h"
+#include <zlib.h>
 
 namespace {
 
@@ -357,24 +358,49 @@ TEST_F(ImageFiles, StreamedRowsMatchWholeImage) {
     }
 }
 
-// A PNG large enough to be deflated in several segments side by side reads
-// back as its bytes, and its file does not depend on the bands.
+// A PNG large enough to be deflated in several segments side by side holds
+// one zlib stream (checked by zlib itself, Adler-32 included) of its
+// scanlines, reads back as its bytes, and its file does not depend on the bands.
 TEST_F(ImageFiles, PngOfManySegmentsReadsBackAndIgnoresBands) {
-    Image image(256, 700);  // 769-byte scanlines: 538 KB, four segments
+    const int width = 256, height = 701;  // 769-byte scanlines: 4 segments of 176 rows, the last of 173
+    Image image(width, height);
     for (std::size_t i = 0; i < image.rgb.size(); ++i) image.rgb[i] = float((i * 7919) % 1000) / 900.0f - 0.05f;
     snell::writeImage(path("whole.png"), image);
-    auto writer = snell::ImageWriter::open(path("bands.png"), 256, 700);
+    auto writer = snell::ImageWriter::open(path("bands.png"), width, height);
     int row = 0;
-    for (int band : {1, 170, 3, 400, 126}) {
+    for (int band : {1, 170, 3, 400, 127}) {
         writer->writeRows(image.pixel(0, row), band);
         row += band;
     }
     writer->commit();
-    EXPECT_EQ(slurp(path("bands.png")), slurp(path("whole.png")));
-    const Image back = snell::readImage(path("whole.png"));
-    ASSERT_EQ(back.width, 256);
-    ASSERT_EQ(back.height, 700);
+    const std::string file = slurp(path("whole.png"));
+    EXPECT_EQ(slurp(path("bands.png")), file);
+
+    // The IDAT chunks' data, joined, inflates to the scanlines: filter byte 0, then RGB bytes.
+    std::string stream;
+    for (std::size_t at = 8; at + 12 <= file.size();) {
+        const auto byte = [&](std::size_t k) { return std::uint32_t(static_cast<unsigned char>(file[k])); };
+        const std::uint32_t length = byte(at) << 24 | byte(at + 1) << 16 | byte(at + 2) << 8 | byte(at + 3);
+        if (file.compare(at + 4, 4, "IDAT") == 0) stream += file.substr(at + 8, length);
+        at += 12 + length;
+    }
+    const std::size_t lineBytes = std::size_t(width) * 3 + 1;
+    std::vector<unsigned char> lines(lineBytes * height + 1);
+    uLongf size = uLongf(lines.size());
+    ASSERT_EQ(uncompress(lines.data(), &size, reinterpret_cast<const Bytef*>(stream.data()), uLong(stream.size())), Z_OK);
+    ASSERT_EQ(size, lineBytes * height);
     std::size_t wrong = 0;
+    for (int y = 0; y < height; ++y) {
+        wrong += lines[std::size_t(y) * lineBytes] != 0;
+        for (std::size_t i = 0; i + 1 < lineBytes; ++i)
+            wrong += lines[std::size_t(y) * lineBytes + 1 + i] != snell::toByte(image.rgb[std::size_t(y) * (lineBytes - 1) + i]);
+    }
+    EXPECT_EQ(wrong, 0u);
+
+    const Image back = snell::readImage(path("whole.png"));
+    ASSERT_EQ(back.width, width);
+    ASSERT_EQ(back.height, height);
+    wrong = 0;
     for (std::size_t i = 0; i < image.rgb.size(); ++i)
         wrong += float(snell::toByte(image.rgb[i])) / 255.0f != back.rgb[i];
     EXPECT_EQ(wrong, 0u);

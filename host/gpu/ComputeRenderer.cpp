@@ -117,10 +117,10 @@ ComputeRenderer::ComputeRenderer(vk::Context& context, const Scene& scene, const
     deviceSharesShadowRays_ = context.isCpuDevice() && context.subgroupSize() >= 2 && context.subgroupSize() <= 16;
     loopBudget_ = limitsLoopIterations(context) ? SNELL_LOOP_BUDGET_LIMITED : 0u;
     // Each scene array becomes a texel buffer (shared_layout.h): its structs
-    // are runs of RGBA32 texels (R32 for a uint array).
+    // are runs of texels, every view RGBA32UI, floats by their bits (lavapipe
+    // compiles its fetch functions for each new format a view has).
     const VkDeviceSize maxTexels = context.properties().limits.maxTexelBufferElements;
-    auto upload = [&](std::uint32_t binding, const auto& v, VkFormat format, const char* what,
-                      VkBufferUsageFlags alsoAs = 0) {
+    auto upload = [&](std::uint32_t binding, const auto& v, const char* what, VkBufferUsageFlags alsoAs = 0) {
         const VkDeviceSize bytes = v.size() * sizeof(v[0]);
         const VkDeviceSize texelBytes = 16;
         if (bytes / texelBytes > maxTexels)
@@ -131,24 +131,21 @@ ComputeRenderer::ComputeRenderer(vk::Context& context, const Scene& scene, const
             context_.createBufferWithData(v.data(), bytes, VK_BUFFER_USAGE_UNIFORM_TEXEL_BUFFER_BIT | alsoAs);
         VkBufferViewCreateInfo info{VK_STRUCTURE_TYPE_BUFFER_VIEW_CREATE_INFO};
         info.buffer = sceneBuffers_[binding].buffer;
-        info.format = format;
+        info.format = VK_FORMAT_R32G32B32A32_UINT;
         info.range = VK_WHOLE_SIZE;
         check(vkCreateBufferView(context_.device(), &info, nullptr, &sceneViews_[binding]), "vkCreateBufferView");
     };
     try {
-        // One format for every view (shared_layout.h): floats go as their bits,
-        // the spheres' materials four a texel.
-        constexpr VkFormat rgba = VK_FORMAT_R32G32B32A32_UINT;
+        // The spheres' materials four a texel.
         std::vector<std::uint32_t> sphereMaterials = layout_.sphereMaterials;
         sphereMaterials.resize((sphereMaterials.size() + 3) / 4 * 4);
-        upload(SNELL_BINDING_SPHERES, layout_.spheres, rgba, "spheres");
-        upload(SNELL_BINDING_SPHERE_MATERIALS, sphereMaterials, rgba, "spheres");
-        upload(SNELL_BINDING_ELLIPSOIDS, layout_.ellipsoids, rgba, "ellipsoids");
-        upload(SNELL_BINDING_MATERIALS, layout_.materials, rgba, "materials");
-        upload(SNELL_BINDING_LIGHTS, layout_.lights, rgba, "lights");
+        upload(SNELL_BINDING_SPHERES, layout_.spheres, "spheres");
+        upload(SNELL_BINDING_SPHERE_MATERIALS, sphereMaterials, "spheres");
+        upload(SNELL_BINDING_ELLIPSOIDS, layout_.ellipsoids, "ellipsoids");
+        upload(SNELL_BINDING_MATERIALS, layout_.materials, "materials");
+        upload(SNELL_BINDING_LIGHTS, layout_.lights, "lights");
         // Read as texels, or through its device address (FrameParams.bvhAddress).
-        upload(SNELL_BINDING_BVH, layout_.nodes, rgba, "BVH nodes",
-               VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT);
+        upload(SNELL_BINDING_BVH, layout_.nodes, "BVH nodes", VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT);
         if (!layout_.sphereBoxes.empty())
             sphereBoxes_ = std::make_unique<vk::BoxAccelerationStructure>(
                 context_, layout_.sphereBoxes.data(), static_cast<std::uint32_t>(layout_.sphereBoxes.size()));
@@ -163,9 +160,9 @@ ComputeRenderer::ComputeRenderer(vk::Context& context, const Scene& scene, const
         sceneBuffers_[SNELL_BINDING_SPHERE_BLOCK] =
             context_.createBufferWithData(blocks.data(), blockBytes, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
         if (precision == gpu::Precision::Fp64) {
-            upload(SNELL_BINDING_SPHERES_LOW, layout_.sphereLows, rgba, "spheres");
-            upload(SNELL_BINDING_ELLIPSOIDS_LOW, layout_.ellipsoidLows, rgba, "ellipsoids");
-            upload(SNELL_BINDING_LIGHTS_LOW, layout_.lightLows, rgba, "lights");
+            upload(SNELL_BINDING_SPHERES_LOW, layout_.sphereLows, "spheres");
+            upload(SNELL_BINDING_ELLIPSOIDS_LOW, layout_.ellipsoidLows, "ellipsoids");
+            upload(SNELL_BINDING_LIGHTS_LOW, layout_.lightLows, "lights");
         }
     } catch (...) {
         destroyBuffers();

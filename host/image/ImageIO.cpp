@@ -8,6 +8,7 @@
 #include <fstream>
 #include <random>
 #include <sstream>
+#include <system_error>
 
 #include <mutex>
 #include <thread>
@@ -186,8 +187,8 @@ private:
 // segments of rows compressed side by side on the cores and joined into one
 // zlib stream, as pigz does: each segment is a raw deflate stream of its own,
 // flushed to a byte boundary, and the stream's Adler-32 is combined from
-// theirs. (libpng deflates on one thread, and at zlib's level 1 that was
-// most of a 512² render's 6 ms of writing.) The segments' rows depend on the
+// theirs. (libpng would deflate on one thread, and at zlib's level 1 that
+// was most of a 512² render's 6 ms of writing.) The segments' rows depend on the
 // image's size only, so the file's bytes do not depend on the cores or on
 // the bands the rows arrive in.
 class PngWriter : public ImageWriter {
@@ -252,7 +253,8 @@ private:
         z.avail_in = uInt(size);
         z.next_out = s.bytes.data();
         z.avail_out = uInt(s.bytes.size());
-        s.ok = deflate(&z, Z_SYNC_FLUSH) == Z_OK && z.avail_in == 0;
+        // (Room left over proves the flush complete.)
+        s.ok = deflate(&z, Z_SYNC_FLUSH) == Z_OK && z.avail_in == 0 && z.avail_out != 0;
         s.bytes.resize(s.bytes.size() - z.avail_out);
         deflateEnd(&z);
         return s;
@@ -266,16 +268,29 @@ private:
         if (count == 0) return;
         std::vector<Segment> parts(count);
         std::atomic<std::size_t> next{0};
-        auto work = [&] {
+        // A segment that fails (out of memory) stays not ok; every thread is
+        // joined before that is reported.
+        auto work = [&]() noexcept {
             for (std::size_t k; (k = next++) < count;) {
                 const std::size_t begin = k * segmentBytes;
-                parts[k] = deflateLines(&lines_[begin], std::min(lines_.size(), begin + segmentBytes) - begin);
+                try {
+                    parts[k] = deflateLines(&lines_[begin], std::min(lines_.size(), begin + segmentBytes) - begin);
+                } catch (const std::exception&) {
+                    parts[k].ok = false;
+                }
             }
         };
-        std::vector<std::thread> helpers;
-        for (std::size_t k = 1; k < std::min<std::size_t>(count, cores()); ++k) helpers.emplace_back(work);
-        work();
-        for (std::thread& t : helpers) t.join();
+        {
+            std::vector<std::jthread> helpers;
+            const std::size_t threads = std::min<std::size_t>(count, cores());
+            helpers.reserve(threads);
+            try {
+                for (std::size_t k = 1; k < threads; ++k) helpers.emplace_back(work);
+            } catch (const std::system_error&) {
+                // No more threads to be had: those started, and this one, do it all.
+            }
+            work();
+        }  // (the helpers join here)
         const std::size_t used = std::min(lines_.size(), count * segmentBytes);
         for (std::size_t k = 0; k < count; ++k) {
             if (!parts[k].ok) throw ImageIOError("cannot write '" + path_ + "': zlib failed (out of memory)");
