@@ -264,7 +264,7 @@ ComputeRenderer::Specialisation ComputeRenderer::specialise(const RenderRequest&
     values[SNELL_SPEC_BVH_DEPTH] = static_cast<std::uint32_t>(layout_.bvhStackSize());
     values[SNELL_SPEC_STACK_IN_REGISTERS] = stackInRegisters();
     values[SNELL_SPEC_SHARE_SHADOW_RAYS] = sharesShadowRays();
-    values[SNELL_SPEC_LIGHTS_IN_FRAME] = layout_.lights.size() <= SNELL_FRAME_LIGHTS;
+    values[SNELL_SPEC_LIGHTS_IN_FRAME] = layout_.lightsInFrame();
     values[SNELL_SPEC_HAS_ELLIPSOIDS] = !layout_.ellipsoids.empty();
     values[SNELL_SPEC_HAS_REFRACTION] = hasRefraction;
     values[SNELL_SPEC_HAS_REFLECTION] = hasReflection;

@@ -250,7 +250,7 @@ FrameParams makeFrameParams(const snell::Scene& scene, const GpuScene& gpuScene,
     splitVec4(camera.pixelRight, 0.0, f.pixelRight, low.pixelRight);
     splitVec4(camera.pixelDown, 0.0, f.pixelDown, low.pixelDown);
     // A few lights again in the frame (FrameParams.lights), with their low parts.
-    if (gpuScene.lights.size() <= SNELL_FRAME_LIGHTS) {
+    if (gpuScene.lightsInFrame()) {
         std::copy(gpuScene.lights.begin(), gpuScene.lights.end(), f.lights);
         std::copy(gpuScene.lightLows.begin(), gpuScene.lightLows.end(), low.lights);
     }

@@ -25,11 +25,11 @@ static_assert(sizeof(BvhNode) == 16 * SNELL_BVH_NODE_TEXELS && offsetof(BvhNode,
               offsetof(BvhNode, child) == 96);
 static_assert(sizeof(SphereBlock) == 32 * SNELL_BLOCK_SPHERES);
 static_assert(offsetof(FrameParams, cornerDir) == 16 &&
-             offsetof(FrameParams, radiance) == 96 && offsetof(FrameParams, imageWidth) == 128 &&
-             offsetof(FrameParams, bvhNodeCount) == 152 && offsetof(FrameParams, sampleCount) == 160 &&
-             offsetof(FrameParams, minWeight) == 172 && offsetof(FrameParams, airEta) == 184 &&
-             offsetof(FrameParams, bvhAddressLow) == 188 && offsetof(FrameParams, lights) == 208 &&
-             sizeof(FrameParams) == 208 + 32 * SNELL_FRAME_LIGHTS);
+              offsetof(FrameParams, radiance) == 96 && offsetof(FrameParams, imageWidth) == 128 &&
+              offsetof(FrameParams, bvhNodeCount) == 152 && offsetof(FrameParams, sampleCount) == 160 &&
+              offsetof(FrameParams, minWeight) == 172 && offsetof(FrameParams, airEta) == 184 &&
+              offsetof(FrameParams, bvhAddressLow) == 188 && offsetof(FrameParams, lights) == 208 &&
+              sizeof(FrameParams) == 208 + 32 * SNELL_FRAME_LIGHTS);
 static_assert(sizeof(TileParams) == 32 && offsetof(TileParams, resume) == 16 &&
               offsetof(TileParams, workgroupStride) == 20 && offsetof(TileParams, strideY) == 28);
 static_assert(sizeof(SlotState) == 176 && offsetof(SlotState, lost) == 32 && offsetof(SlotState, pixel) == 96 &&
@@ -90,6 +90,8 @@ struct GpuScene {
     double bvhBuildMs = 0.0;
 
     bool usesBvh() const { return !nodes.empty(); }
+    // The lights are also in FrameParams.lights (SNELL_SPEC_LIGHTS_IN_FRAME).
+    bool lightsInFrame() const { return lights.size() <= SNELL_FRAME_LIGHTS; }
     // Bytes of scene data the GPU holds (low parts included).
     std::size_t bytes() const;
 };
