@@ -98,7 +98,8 @@ using uint = std::uint32_t;
 #define SNELL_SPEC_STACK_IN_REGISTERS 20  // the walk's stack in registers (trace.comp, pushEntry)
 #define SNELL_SPEC_SHARE_SHADOW_RAYS 21  // a subgroup's shadow rays walked by all its lanes (trace.comp, shadeLightsShared)
 #define SNELL_SPEC_LIGHTS_IN_FRAME 22  // the lights are read from FrameParams.lights
-#define SNELL_SPEC_COUNT 23
+#define SNELL_SPEC_STACKS_BY_ADDRESS 23  // the ray and media stacks through their addresses (FrameParams.rayStackAddress)
+#define SNELL_SPEC_COUNT 24
 // The deepest walk stack kept in registers (entries); a deeper one is an array
 // at a per-lane index.
 #define SNELL_REGISTER_STACK_LIMIT 32
@@ -308,6 +309,10 @@ struct FrameParams {
     float airEta;       // the index of refraction outside every sphere (SPEC §4.5)
     uint bvhAddressLow; // the device address of the BVH's nodes (with SNELL_SPEC_BVH_WORDS), low 32 bits
     uint bvhAddressHigh;
+    uint rayStackAddressLow;    // the device addresses of the ray and media stacks (with
+    uint rayStackAddressHigh;   // SNELL_SPEC_STACKS_BY_ADDRESS), low and high 32 bits
+    uint mediaStackAddressLow;
+    uint mediaStackAddressHigh;
     uint pad0;
     uint pad1;
     uint pad2;

@@ -102,6 +102,9 @@ layout(set = 0, binding = SNELL_BINDING_LIGHTS) uniform utextureBuffer lightTexe
 layout(set = 0, binding = SNELL_BINDING_BVH) uniform utextureBuffer bvhTexels;
 // The BVH's nodes again, the same buffer read through its device address.
 layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer BvhWords { uvec4 words[]; };
+// The ray and media stacks again, through their device addresses.
+layout(buffer_reference, std430, buffer_reference_align = 16) buffer PendingRays { PendingRay rays[]; };
+layout(buffer_reference, std430, buffer_reference_align = 4) buffer MediaEntries { uint spheres[]; };
 #ifdef SNELL_RAY_QUERY
 layout(set = 0, binding = SNELL_BINDING_ACCELERATION) uniform accelerationStructureEXT sphereBoxes;
 #endif
@@ -386,6 +389,33 @@ uint helpedShare;  // the share the invocation takes its pixels from (takePixel)
 uint stackEntry(uint slot, uint k) { return k * invocations + slot; }
 uint frontierEntry(uint slot, uint k) { return (RAY_STACK + k % max(FRONTIER, 1u)) * invocations + slot; }
 
+// The stacks' entries, through whichever the driver reads and writes faster
+// at per-lane indices: Mesa 25's lavapipe checks each lane's offset into a
+// storage buffer against its size, where through an address a load or store
+// is one masked gather or scatter a component; Mesa 22.3 goes lane by lane
+// there (docs/performance.md, "The ray stack through its address").
+layout(constant_id = SNELL_SPEC_STACKS_BY_ADDRESS) const bool STACKS_BY_ADDRESS = false;
+// (Macros, not functions: SPIRV-Tools' dead-code pass of Debian 12 fails on
+// a call that returns a buffer reference.)
+#define pendingRays() PendingRays(uvec2(frame.rayStackAddressLow, frame.rayStackAddressHigh))
+#define mediaEntries() MediaEntries(uvec2(frame.mediaStackAddressLow, frame.mediaStackAddressHigh))
+void storePending(uint entry, PendingRay p) {
+    if (STACKS_BY_ADDRESS) pendingRays().rays[entry] = p;
+    else rayStack[entry] = p;
+}
+PendingRay loadPending(uint entry) {
+    if (STACKS_BY_ADDRESS) return pendingRays().rays[entry];
+    return rayStack[entry];
+}
+void storeMedium(uint i, uint sphere) {
+    if (STACKS_BY_ADDRESS) mediaEntries().spheres[i] = sphere;
+    else mediaStack[i] = sphere;
+}
+uint loadMedium(uint i) {
+    if (STACKS_BY_ADDRESS) return mediaEntries().spheres[i];
+    return mediaStack[i];
+}
+
 void storeRay(uint entry, Ray r) {
 #ifdef SNELL_FP64
     vec3 origin, originLow, dir, dirLow;
@@ -396,17 +426,17 @@ void storeRay(uint entry, Ray r) {
 #else
     vec3 origin = r.origin, dir = r.dir;
 #endif
-    rayStack[entry] = PendingRay(vec4(origin, 0.0), vec4(dir, 0.0), vec4(r.weight, 0.0), r.depth, r.fromSphere,
-                                 (r.inward ? 1u : 0u) | (r.mediaCount << 1), r.resumeShading);
+    storePending(entry, PendingRay(vec4(origin, 0.0), vec4(dir, 0.0), vec4(r.weight, 0.0), r.depth, r.fromSphere,
+                                   (r.inward ? 1u : 0u) | (r.mediaCount << 1), r.resumeShading));
     [[unroll]] for (int k = 0; k < MAX_MEDIA; ++k)
-        if (uint(k) < r.mediaCount) mediaStack[entry * uint(MAX_MEDIA) + uint(k)] = media[k];
+        if (uint(k) < r.mediaCount) storeMedium(entry * uint(MAX_MEDIA) + uint(k), media[k]);
 }
 
 Ray loadRay(uint entry) {
-    PendingRay p = rayStack[entry];
+    PendingRay p = loadPending(entry);
     uint mediaCount = p.flags >> 1;
     [[unroll]] for (int k = 0; k < MAX_MEDIA; ++k)
-        if (uint(k) < mediaCount) media[k] = mediaStack[entry * uint(MAX_MEDIA) + uint(k)];
+        if (uint(k) < mediaCount) media[k] = loadMedium(entry * uint(MAX_MEDIA) + uint(k));
     return Ray(WIDE(p.origin, rayStackLow[entry].origin).xyz, WIDE(p.direction, rayStackLow[entry].direction).xyz,
                p.weight.rgb, p.depth, p.fromSphere, (p.flags & 1u) != 0u, mediaCount, p.resumeShading);
 }

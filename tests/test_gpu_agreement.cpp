@@ -659,6 +659,38 @@ TEST(GpuBvhWords, AddressReadsTraceTheTexelsImage) {
                        "the BVH's two views");
 }
 
+// The ray and media stacks are read and written through their device
+// addresses or as storage buffers, whichever the driver does faster
+// (trace.comp, storePending): both trace the same image, bit for bit, also
+// where the invocations suspend mid-tree and the stacks carry their rays from
+// one dispatch to the next; nested media (glass in water), amplifying trees
+// (becker-1n), a BVH, the fp64 kernel (its low parts stay in a storage buffer).
+TEST(GpuStacks, AddressesTraceTheStorageBuffersImage) {
+    const std::pair<const char*, snell::gpu::Precision> cases[] = {
+        {SNELL_SOURCE_DIR "/scenes/glass.scn", snell::gpu::Precision::Fp32},
+        {SNELL_SOURCE_DIR "/scenes/glass.scn", snell::gpu::Precision::Fp64},
+        {SNELL_SOURCE_DIR "/scenes/hard/glass-in-water-gap-0.scn", snell::gpu::Precision::Fp32},
+        {SNELL_SHARED_DIR "/course-scenes/becker-1n.scn", snell::gpu::Precision::Fp32},
+        {SNELL_SOURCE_DIR "/scenes/grid.scn", snell::gpu::Precision::Fp32}};
+    for (const auto& [file, precision] : cases) {
+        const bool wide = precision == snell::gpu::Precision::Fp64;
+        SCOPED_TRACE(std::string(file) + (wide ? " fp64" : " fp32"));
+        if (wide && !context().float64Supported()) continue;
+        const snell::Scene scene = snell::parseSceneFile(file);
+        const snell::RenderRequest request = wholeImage(scene, 48);
+        snell::ComputeRenderer renderer(context(), scene, request.camera, precision);
+        renderer.addressStacks(false);
+        const snell::GpuRenderResult buffers = renderer.render(request, false);
+        renderer.addressStacks(true);
+        const snell::GpuRenderResult addresses = renderer.render(request, false);
+        renderer.forceLoopBudget(48);
+        const snell::GpuRenderResult resumed = renderer.render(request, false);
+        EXPECT_GT(resumed.dispatches, 2 * addresses.dispatches) << "the budget forced too few suspensions to test";
+        EXPECT_EQ(pixelsThatDiffer(buffers.image, addresses.image), 0u) << "pixels that differ between the stacks";
+        EXPECT_EQ(pixelsThatDiffer(buffers.image, resumed.image), 0u) << "pixels that differ once suspended";
+    }
+}
+
 // The walk's stack lives in registers where it is short enough, else in an
 // array (trace.comp, pushEntry): both trace the same image, bit for bit.
 // SphereFlake4's stack (30 entries) is near the limit of 32.

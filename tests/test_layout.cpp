@@ -73,8 +73,8 @@ glm::vec3 lowerOf(const gpu::BvhNode& n, int k) { return {n.lowerX[k], n.lowerY[
 glm::vec3 upperOf(const gpu::BvhNode& n, int k) { return {n.upperX[k], n.upperY[k], n.upperZ[k]}; }
 
 TEST(Layout, FrameParams) {
-    EXPECT_EQ(sizeof(gpu::FrameParams), 208u + 32u * SNELL_FRAME_LIGHTS);
-    EXPECT_EQ(offsetof(gpu::FrameParams, lights), 208u);
+    EXPECT_EQ(sizeof(gpu::FrameParams), 224u + 32u * SNELL_FRAME_LIGHTS);
+    EXPECT_EQ(offsetof(gpu::FrameParams, lights), 224u);
     EXPECT_EQ(offsetof(gpu::FrameParams, primaryStart), 0u);
     EXPECT_EQ(offsetof(gpu::FrameParams, cornerDir), 16u);
     EXPECT_EQ(offsetof(gpu::FrameParams, pixelRight), 32u);

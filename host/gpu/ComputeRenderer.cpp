@@ -25,6 +25,9 @@ namespace {
 
 
 constexpr VkBufferUsageFlags kStorage = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+// The ray and media stacks, read as storage buffers or through their addresses
+// (SNELL_SPEC_STACKS_BY_ADDRESS).
+constexpr VkBufferUsageFlags kStack = kStorage | VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT;
 
 // The descriptor type of each binding of shared_layout.h.
 VkDescriptorType descriptorType(std::uint32_t binding) {
@@ -98,12 +101,15 @@ ComputeRenderer::ComputeRenderer(vk::Context& context, const Scene& scene, const
                            (traversal == gpu::Traversal::Auto && !context.isCpuDevice()));
     const auto start = Clock::now();
     layout_ = gpu::buildGpuScene(scene, camera, precision, bvh, rayQuery);
-    // Mesa 25's lavapipe calls a function for each texel fetch; its loads
-    // from the nodes' device address are faster in the BVH walk (and faster
-    // than its bounds-checked storage-buffer loads), where Mesa 22.3 inlines
-    // its fetches (docs/performance.md, "The BVH as a storage buffer", "The
-    // walk's floor").
-    bvhWords_ = context.isLlvmpipe() && context.mesaMajor() >= 25;
+    // Mesa 25's lavapipe calls a function for each texel fetch and checks
+    // each lane's offset into a storage buffer against its size; its loads
+    // and stores through a device address are faster, in the BVH walk and on
+    // the ray and media stacks. Mesa 22.3 inlines its fetches and goes lane by
+    // lane through an address (docs/performance.md, "The BVH as a storage
+    // buffer", "The walk's floor", "The ray stack through its address").
+    const bool addressesFaster = context.isLlvmpipe() && context.mesaMajor() >= 25;
+    bvhWords_ = addressesFaster;
+    stacksByAddress_ = addressesFaster;
     // A CPU device runs a SIMD row's stores at per-lane indices lane by lane;
     // a GPU keeps such a stack in its local memory (unmeasured there: left
     // as it was). docs/performance.md, "The walk's stack in registers".
@@ -265,6 +271,7 @@ ComputeRenderer::Specialisation ComputeRenderer::specialise(const RenderRequest&
     values[SNELL_SPEC_STACK_IN_REGISTERS] = stackInRegisters();
     values[SNELL_SPEC_SHARE_SHADOW_RAYS] = sharesShadowRays();
     values[SNELL_SPEC_LIGHTS_IN_FRAME] = layout_.lightsInFrame();
+    values[SNELL_SPEC_STACKS_BY_ADDRESS] = stacksByAddress_;
     values[SNELL_SPEC_HAS_ELLIPSOIDS] = !layout_.ellipsoids.empty();
     values[SNELL_SPEC_HAS_REFRACTION] = hasRefraction;
     values[SNELL_SPEC_HAS_REFLECTION] = hasReflection;
@@ -643,13 +650,13 @@ void ComputeRenderer::ensureBuffers(Pipeline& p, const RenderRequest& request, c
     const bool wide = layout_.precision == gpu::Precision::Fp64;
     gpu::FrameParams frameLow{};
     gpu::FrameParams frame = gpu::makeFrameParams(scene_, layout_, request, &frameLow);
-    const VkDeviceAddress nodes = context_.deviceAddress(sceneBuffers_[SNELL_BINDING_BVH]);
-    frame.bvhAddressLow = static_cast<std::uint32_t>(nodes);
-    frame.bvhAddressHigh = static_cast<std::uint32_t>(nodes >> 32);
-    context_.destroy(p.frame);
-    context_.destroy(p.frameLow);
-    p.frame = context_.createBufferWithData(&frame, sizeof frame, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
-    if (wide) p.frameLow = context_.createBufferWithData(&frameLow, sizeof frameLow, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
+    // A device address, as the two words GL_EXT_buffer_reference_uvec2 reads.
+    const auto addressOf = [this](const vk::Buffer& buffer, std::uint32_t& low, std::uint32_t& high) {
+        const VkDeviceAddress address = context_.deviceAddress(buffer);
+        low = static_cast<std::uint32_t>(address);
+        high = static_cast<std::uint32_t>(address >> 32);
+    };
+    addressOf(sceneBuffers_[SNELL_BINDING_BVH], frame.bvhAddressLow, frame.bvhAddressHigh);
     if (plan.invocations > p.slots) {
         for (vk::Buffer* b : {&p.counters, &p.slotStates, &p.rayStack, &p.mediaStack, &p.rayStackLow})
             context_.destroy(*b);
@@ -662,11 +669,13 @@ void ComputeRenderer::ensureBuffers(Pipeline& p, const RenderRequest& request, c
         p.counters = context_.createBuffer(counterCount(slots / SNELL_WORKGROUP_SIZE) * sizeof(std::uint32_t),
                                            kStorage, Memory::DeviceMapped);
         p.slotStates = context_.createBuffer(slots * sizeof(gpu::SlotState), kStorage, Memory::HostCached);
-        p.rayStack = context_.createBuffer(slots * p.rayEntries * sizeof(gpu::PendingRay), kStorage, Memory::Device);
-        p.mediaStack = context_.createBuffer(slots * p.rayEntries * p.maxMedia * 4, kStorage, Memory::Device);
+        p.rayStack = context_.createBuffer(slots * p.rayEntries * sizeof(gpu::PendingRay), kStack, Memory::Device);
+        p.mediaStack = context_.createBuffer(slots * p.rayEntries * p.maxMedia * 4, kStack, Memory::Device);
         if (wide)
             p.rayStackLow = context_.createBuffer(slots * p.rayEntries * sizeof(gpu::PendingRay), kStorage, Memory::Device);
     }
+    addressOf(p.rayStack, frame.rayStackAddressLow, frame.rayStackAddressHigh);
+    addressOf(p.mediaStack, frame.mediaStackAddressLow, frame.mediaStackAddressHigh);
     if (plan.tilePixels() > p.tilePixels) {
         context_.destroy(p.output);
         p.tilePixels = plan.tilePixels();
@@ -674,6 +683,12 @@ void ComputeRenderer::ensureBuffers(Pipeline& p, const RenderRequest& request, c
         // (on lavapipe, an imageStore in a loop costs 13x a buffer store).
         p.output = context_.createBuffer(p.tilePixels * sizeof(gpu::OutputPixel), kStorage, vk::Context::Memory::HostCached);
     }
+
+    // The frame's block last: it holds the stacks' addresses.
+    context_.destroy(p.frame);
+    context_.destroy(p.frameLow);
+    p.frame = context_.createBufferWithData(&frame, sizeof frame, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
+    if (wide) p.frameLow = context_.createBufferWithData(&frameLow, sizeof frameLow, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);
 
     std::array<VkDescriptorBufferInfo, SNELL_BINDING_LIMIT> bufferInfo{};
     std::array<const vk::Buffer*, SNELL_BINDING_LIMIT> buffers{};

@@ -103,6 +103,10 @@ public:
     // image is the same.
     void readBvhWords(bool words) { bvhWords_ = words; }
     bool readsBvhWords() const { return bvhWords_; }
+    // Testing: whether the ray and media stacks are read and written through
+    // their device addresses or as storage buffers (by default as the driver
+    // does faster). The image is the same.
+    void addressStacks(bool byAddress) { stacksByAddress_ = byAddress; }
     // Testing: whether the walk's stack may live in registers where it fits
     // (SNELL_REGISTER_STACK_LIMIT; by default on CPU devices), else an array at
     // a per-lane index. The image is the same either way.
@@ -161,6 +165,7 @@ private:
     bool foldSpecialisation_ = true;
     bool useShaderObjects_ = true;
     bool bvhWords_ = false;
+    bool stacksByAddress_ = false;
     bool stackInRegisters_ = false;
     bool shareShadowRays_ = true;
     bool deviceSharesShadowRays_ = false;  // a CPU device with subgroups of up to 16 lanes

@@ -28,8 +28,8 @@ static_assert(offsetof(FrameParams, cornerDir) == 16 &&
               offsetof(FrameParams, radiance) == 96 && offsetof(FrameParams, imageWidth) == 128 &&
               offsetof(FrameParams, bvhNodeCount) == 152 && offsetof(FrameParams, sampleCount) == 160 &&
               offsetof(FrameParams, minWeight) == 172 && offsetof(FrameParams, airEta) == 184 &&
-              offsetof(FrameParams, bvhAddressLow) == 188 && offsetof(FrameParams, lights) == 208 &&
-              sizeof(FrameParams) == 208 + 32 * SNELL_FRAME_LIGHTS);
+              offsetof(FrameParams, bvhAddressLow) == 188 && offsetof(FrameParams, lights) == 224 &&
+              sizeof(FrameParams) == 224 + 32 * SNELL_FRAME_LIGHTS);
 static_assert(sizeof(TileParams) == 32 && offsetof(TileParams, resume) == 16 &&
               offsetof(TileParams, workgroupStride) == 20 && offsetof(TileParams, strideY) == 28);
 static_assert(sizeof(SlotState) == 176 && offsetof(SlotState, lost) == 32 && offsetof(SlotState, pixel) == 96 &&
