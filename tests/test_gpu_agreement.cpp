@@ -664,30 +664,47 @@ TEST(GpuBvhWords, AddressReadsTraceTheTexelsImage) {
 // (trace.comp, storePending): both trace the same image, bit for bit, also
 // where the invocations suspend mid-tree and the stacks carry their rays from
 // one dispatch to the next; nested media (glass in water), amplifying trees
-// (becker-1n), a BVH, the fp64 kernel (its low parts stay in a storage buffer).
+// (becker-1n), a BVH, the fp64 kernel (its low parts stay in a storage
+// buffer), and the deepest stack of a fixed tree without a cut-off.
 TEST(GpuStacks, AddressesTraceTheStorageBuffersImage) {
-    const std::pair<const char*, snell::gpu::Precision> cases[] = {
-        {SNELL_SOURCE_DIR "/scenes/glass.scn", snell::gpu::Precision::Fp32},
-        {SNELL_SOURCE_DIR "/scenes/glass.scn", snell::gpu::Precision::Fp64},
-        {SNELL_SOURCE_DIR "/scenes/hard/glass-in-water-gap-0.scn", snell::gpu::Precision::Fp32},
-        {SNELL_SHARED_DIR "/course-scenes/becker-1n.scn", snell::gpu::Precision::Fp32},
-        {SNELL_SOURCE_DIR "/scenes/grid.scn", snell::gpu::Precision::Fp32}};
-    for (const auto& [file, precision] : cases) {
-        const bool wide = precision == snell::gpu::Precision::Fp64;
-        SCOPED_TRACE(std::string(file) + (wide ? " fp64" : " fp32"));
+    struct Case {
+        const char* file;
+        snell::gpu::Precision precision;
+        bool fixedTree;  // --depth 5 --min-weight 0 --tolerance 0 (POV-Ray's settings)
+    };
+    const Case cases[] = {{SNELL_SOURCE_DIR "/scenes/glass.scn", snell::gpu::Precision::Fp32, false},
+                          {SNELL_SOURCE_DIR "/scenes/glass.scn", snell::gpu::Precision::Fp64, false},
+                          {SNELL_SOURCE_DIR "/scenes/hard/glass-in-water-gap-0.scn", snell::gpu::Precision::Fp32, false},
+                          {SNELL_SHARED_DIR "/course-scenes/becker-1n.scn", snell::gpu::Precision::Fp32, false},
+                          {SNELL_SOURCE_DIR "/scenes/grid.scn", snell::gpu::Precision::Fp32, false},
+                          {SNELL_SHARED_DIR "/bench-scenes/glass.scn", snell::gpu::Precision::Fp32, true}};
+    for (const Case& c : cases) {
+        const bool wide = c.precision == snell::gpu::Precision::Fp64;
+        SCOPED_TRACE(std::string(c.file) + (wide ? " fp64" : " fp32") + (c.fixedTree ? ", fixed tree" : ""));
         if (wide && !context().float64Supported()) continue;
-        const snell::Scene scene = snell::parseSceneFile(file);
-        const snell::RenderRequest request = wholeImage(scene, 48);
-        snell::ComputeRenderer renderer(context(), scene, request.camera, precision);
-        renderer.addressStacks(false);
-        const snell::GpuRenderResult buffers = renderer.render(request, false);
-        renderer.addressStacks(true);
-        const snell::GpuRenderResult addresses = renderer.render(request, false);
-        renderer.forceLoopBudget(48);
-        const snell::GpuRenderResult resumed = renderer.render(request, false);
-        EXPECT_GT(resumed.dispatches, 2 * addresses.dispatches) << "the budget forced too few suspensions to test";
-        EXPECT_EQ(pixelsThatDiffer(buffers.image, addresses.image), 0u) << "pixels that differ between the stacks";
-        EXPECT_EQ(pixelsThatDiffer(buffers.image, resumed.image), 0u) << "pixels that differ once suspended";
+        const snell::Scene scene = snell::parseSceneFile(c.file);
+        snell::RenderRequest request = wholeImage(scene, 48);
+        if (c.fixedTree) {
+            request.trace.maxDepth = 5;
+            request.trace.minWeight = 0.0;
+            request.trace.tolerance = 0.0;
+        }
+        std::vector<snell::Image> images;
+        for (const bool byAddress : {false, true}) {
+            snell::ComputeRenderer renderer(context(), scene, request.camera, c.precision);
+            renderer.addressStacks(byAddress);
+            EXPECT_EQ(renderer.addressesStacks(), byAddress);
+            const snell::GpuRenderResult whole = renderer.render(request, false);
+            EXPECT_EQ(renderer.kernelAddressedStacks(), byAddress);
+            renderer.forceLoopBudget(48);
+            const snell::GpuRenderResult resumed = renderer.render(request, false);
+            EXPECT_GT(resumed.dispatches, 2 * whole.dispatches) << "the budget forced too few suspensions to test";
+            ASSERT_EQ(whole.image.rgb.size(), std::size_t(3 * 48 * 48));
+            ASSERT_EQ(resumed.image.rgb.size(), whole.image.rgb.size());
+            EXPECT_EQ(pixelsThatDiffer(whole.image, resumed.image), 0u) << "pixels that differ once suspended";
+            images.push_back(whole.image);
+        }
+        EXPECT_EQ(pixelsThatDiffer(images[0], images[1]), 0u) << "pixels that differ between the stacks";
     }
 }
 

@@ -100,6 +100,10 @@ TEST(Layout, FrameParams) {
     EXPECT_EQ(offsetof(gpu::FrameParams, airEta), 184u);
     EXPECT_EQ(offsetof(gpu::FrameParams, bvhAddressLow), 188u);
     EXPECT_EQ(offsetof(gpu::FrameParams, bvhAddressHigh), 192u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, rayStackAddressLow), 196u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, rayStackAddressHigh), 200u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, mediaStackAddressLow), 204u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, mediaStackAddressHigh), 208u);
 }
 
 TEST(Layout, TileParams) {

@@ -244,9 +244,7 @@ std::optional<WalkFloor> measureWalkFloor(vk::Context& context, const Scene& sce
         vk::Buffer nodes = context.createBufferWithData(layout.nodes.data(), layout.nodes.size() * sizeof(gpu::BvhNode),
                                                         VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT);
         buffers.push_back(nodes);
-        const VkDeviceAddress address = context.deviceAddress(nodes);
-        frame.bvhAddressLow = static_cast<std::uint32_t>(address);
-        frame.bvhAddressHigh = static_cast<std::uint32_t>(address >> 32);
+        gpu::splitAddress(context.deviceAddress(nodes), frame.bvhAddressLow, frame.bvhAddressHigh);
         buffers.push_back(context.createBufferWithData(&frame, sizeof frame, storage));
         buffers.push_back(context.createBufferWithData(layout.spheres.data(), layout.spheres.size() * sizeof(gpu::Sphere), storage));
         buffers.push_back(context.createBufferWithData(ellipsoids.data(), ellipsoids.size() * sizeof(gpu::Ellipsoid), storage));

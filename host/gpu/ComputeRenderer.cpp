@@ -629,6 +629,10 @@ ComputeRenderer::TilePlan ComputeRenderer::planTiles(const RenderRequest& reques
 
 bool ComputeRenderer::kernelFolded() const { return cached_ && cached_->folded; }
 
+bool ComputeRenderer::kernelAddressedStacks() const {
+    return cached_ && cached_->values[SNELL_SPEC_STACKS_BY_ADDRESS] != 0;
+}
+
 const char* ComputeRenderer::kernelObject() const {
     if (!cached_) return "none";
     if (!cached_->shader.shader) return "pipeline";
@@ -650,13 +654,7 @@ void ComputeRenderer::ensureBuffers(Pipeline& p, const RenderRequest& request, c
     const bool wide = layout_.precision == gpu::Precision::Fp64;
     gpu::FrameParams frameLow{};
     gpu::FrameParams frame = gpu::makeFrameParams(scene_, layout_, request, &frameLow);
-    // A device address, as the two words GL_EXT_buffer_reference_uvec2 reads.
-    const auto addressOf = [this](const vk::Buffer& buffer, std::uint32_t& low, std::uint32_t& high) {
-        const VkDeviceAddress address = context_.deviceAddress(buffer);
-        low = static_cast<std::uint32_t>(address);
-        high = static_cast<std::uint32_t>(address >> 32);
-    };
-    addressOf(sceneBuffers_[SNELL_BINDING_BVH], frame.bvhAddressLow, frame.bvhAddressHigh);
+    gpu::splitAddress(context_.deviceAddress(sceneBuffers_[SNELL_BINDING_BVH]), frame.bvhAddressLow, frame.bvhAddressHigh);
     if (plan.invocations > p.slots) {
         for (vk::Buffer* b : {&p.counters, &p.slotStates, &p.rayStack, &p.mediaStack, &p.rayStackLow})
             context_.destroy(*b);
@@ -674,8 +672,8 @@ void ComputeRenderer::ensureBuffers(Pipeline& p, const RenderRequest& request, c
         if (wide)
             p.rayStackLow = context_.createBuffer(slots * p.rayEntries * sizeof(gpu::PendingRay), kStorage, Memory::Device);
     }
-    addressOf(p.rayStack, frame.rayStackAddressLow, frame.rayStackAddressHigh);
-    addressOf(p.mediaStack, frame.mediaStackAddressLow, frame.mediaStackAddressHigh);
+    gpu::splitAddress(context_.deviceAddress(p.rayStack), frame.rayStackAddressLow, frame.rayStackAddressHigh);
+    gpu::splitAddress(context_.deviceAddress(p.mediaStack), frame.mediaStackAddressLow, frame.mediaStackAddressHigh);
     if (plan.tilePixels() > p.tilePixels) {
         context_.destroy(p.output);
         p.tilePixels = plan.tilePixels();
@@ -684,7 +682,7 @@ void ComputeRenderer::ensureBuffers(Pipeline& p, const RenderRequest& request, c
         p.output = context_.createBuffer(p.tilePixels * sizeof(gpu::OutputPixel), kStorage, vk::Context::Memory::HostCached);
     }
 
-    // The frame's block last: it holds the stacks' addresses.
+    // The frame's block after the stacks: it holds their addresses.
     context_.destroy(p.frame);
     context_.destroy(p.frameLow);
     p.frame = context_.createBufferWithData(&frame, sizeof frame, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT);

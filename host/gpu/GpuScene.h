@@ -28,7 +28,8 @@ static_assert(offsetof(FrameParams, cornerDir) == 16 &&
               offsetof(FrameParams, radiance) == 96 && offsetof(FrameParams, imageWidth) == 128 &&
               offsetof(FrameParams, bvhNodeCount) == 152 && offsetof(FrameParams, sampleCount) == 160 &&
               offsetof(FrameParams, minWeight) == 172 && offsetof(FrameParams, airEta) == 184 &&
-              offsetof(FrameParams, bvhAddressLow) == 188 && offsetof(FrameParams, lights) == 224 &&
+              offsetof(FrameParams, bvhAddressLow) == 188 && offsetof(FrameParams, rayStackAddressLow) == 196 &&
+              offsetof(FrameParams, mediaStackAddressLow) == 204 && offsetof(FrameParams, lights) == 224 &&
               sizeof(FrameParams) == 224 + 32 * SNELL_FRAME_LIGHTS);
 static_assert(sizeof(TileParams) == 32 && offsetof(TileParams, resume) == 16 &&
               offsetof(TileParams, workgroupStride) == 20 && offsetof(TileParams, strideY) == 28);
@@ -105,6 +106,13 @@ double primaryStartDistance(const snell::Scene& scene, const snell::dvec3& eye);
 // The frame parameters of one render request (its camera, size, samples and
 // trace settings); with `lowParts`, also the low parts of its float pairs (for
 // the fp64 shader).
+// A device address as the two words GL_EXT_buffer_reference_uvec2 reads
+// (FrameParams.bvhAddress, rayStackAddress, mediaStackAddress).
+inline void splitAddress(std::uint64_t address, std::uint32_t& low, std::uint32_t& high) {
+    low = static_cast<std::uint32_t>(address);
+    high = static_cast<std::uint32_t>(address >> 32);
+}
+
 FrameParams makeFrameParams(const snell::Scene& scene, const GpuScene& gpuScene, const snell::RenderRequest& request,
                             FrameParams* lowParts = nullptr);
 
