@@ -107,7 +107,6 @@ public:
     // their device addresses or as storage buffers (by default as the driver
     // does faster). The image is the same.
     void addressStacks(bool byAddress) { stacksByAddress_ = byAddress; }
-    bool addressesStacks() const { return stacksByAddress_; }
     bool kernelAddressedStacks() const;  // the last render's kernel did
     // Testing: whether the walk's stack may live in registers where it fits
     // (SNELL_REGISTER_STACK_LIMIT; by default on CPU devices), else an array at

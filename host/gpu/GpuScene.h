@@ -103,9 +103,6 @@ GpuScene buildGpuScene(const snell::Scene& scene, const snell::Camera& camera,
 // How far primary rays from `eye` can go before they could meet any sphere.
 double primaryStartDistance(const snell::Scene& scene, const snell::dvec3& eye);
 
-// The frame parameters of one render request (its camera, size, samples and
-// trace settings); with `lowParts`, also the low parts of its float pairs (for
-// the fp64 shader).
 // A device address as the two words GL_EXT_buffer_reference_uvec2 reads
 // (FrameParams.bvhAddress, rayStackAddress, mediaStackAddress).
 inline void splitAddress(std::uint64_t address, std::uint32_t& low, std::uint32_t& high) {
@@ -113,6 +110,9 @@ inline void splitAddress(std::uint64_t address, std::uint32_t& low, std::uint32_
     high = static_cast<std::uint32_t>(address >> 32);
 }
 
+// The frame parameters of one render request (its camera, size, samples and
+// trace settings); with `lowParts`, also the low parts of its float pairs (for
+// the fp64 shader).
 FrameParams makeFrameParams(const snell::Scene& scene, const GpuScene& gpuScene, const snell::RenderRequest& request,
                             FrameParams* lowParts = nullptr);
 
