@@ -14,6 +14,7 @@
 #include "shared_layout.h"
 #include "kernel_layout.h"
 #include "intersect.glsl"
+#include "wide_words.glsl"
 
 layout(local_size_x = SNELL_KERNEL_GROUP_SIZE) in;
 layout(constant_id = 0) const uint BVH_DEPTH = 1u;
@@ -28,10 +29,10 @@ layout(set = 0, binding = 4, std430) writeonly buffer ResultBuffer { uvec4 resul
 
 const uint NONE = 0xffffffffu;
 
-// The nodes through their device address, as the renderer reads them on
-// lavapipe (shared_layout.h): the fastest of its three ways there.
-layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer BvhWords { uvec4 words[]; };
-uvec4 bvhWord(int i) { return BvhWords(uvec2(frame.bvhAddressLow, frame.bvhAddressHigh)).words[i]; }
+// The nodes through their device address as 64-bit halves, as the renderer
+// reads them on lavapipe (shared_layout.h): the fastest of its ways there.
+layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer BvhWords { u64vec2 words[]; };
+uvec4 bvhWord(int i) { return fromHalves(BvhWords(uvec2(frame.bvhAddressLow, frame.bvhAddressHigh)).words[i]); }
 
 mat4 ellipsoidMatrix(uint e) {
     Ellipsoid m = ellipsoids[e];

@@ -17,8 +17,9 @@
 // (FrameParams.bvhAddress, GL_EXT_buffer_reference): Mesa 25's lavapipe calls
 // a function for every texel fetch, which in the walk's seven fetches a node
 // costs more than loads; and it loads from an address without the per-lane
-// bounds checks of a storage buffer, nor its 128 MiB limit
-// (docs/performance.md, "The BVH as a storage buffer", "The walk's floor").
+// bounds checks of a storage buffer, nor its 128 MiB limit, each word as two
+// 64-bit halves (wide_words.glsl; docs/performance.md, "The BVH as a storage
+// buffer", "The walk's floor", "Words loaded as 64-bit halves").
 #ifndef SNELL_SHARED_LAYOUT_H
 #define SNELL_SHARED_LAYOUT_H
 

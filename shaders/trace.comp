@@ -25,6 +25,7 @@
 #endif
 #include "shared_layout.h"
 #include "intersect.glsl"
+#include "wide_words.glsl"
 
 layout(local_size_x = SNELL_WORKGROUP_SIZE) in;
 
@@ -100,10 +101,12 @@ layout(set = 0, binding = SNELL_BINDING_ELLIPSOIDS) uniform utextureBuffer ellip
 layout(set = 0, binding = SNELL_BINDING_MATERIALS) uniform utextureBuffer materialTexels;
 layout(set = 0, binding = SNELL_BINDING_LIGHTS) uniform utextureBuffer lightTexels;
 layout(set = 0, binding = SNELL_BINDING_BVH) uniform utextureBuffer bvhTexels;
-// The BVH's nodes again, the same buffer read through its device address.
-layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer BvhWords { uvec4 words[]; };
-// The ray and media stacks again, through their device addresses.
-layout(buffer_reference, std430, buffer_reference_align = 16) buffer PendingRays { PendingRay rays[]; };
+// The BVH's nodes again, the same buffer read through its device address,
+// each word as two 64-bit halves (wide_words.glsl).
+layout(buffer_reference, std430, buffer_reference_align = 16) readonly buffer BvhWords { u64vec2 words[]; };
+// The ray and media stacks again, through their device addresses (a pending
+// ray as four words of two halves).
+layout(buffer_reference, std430, buffer_reference_align = 16) buffer PendingRays { u64vec2 words[]; };
 layout(buffer_reference, std430, buffer_reference_align = 4) buffer MediaEntries { uint spheres[]; };
 #ifdef SNELL_RAY_QUERY
 layout(set = 0, binding = SNELL_BINDING_ACCELERATION) uniform accelerationStructureEXT sphereBoxes;
@@ -197,7 +200,7 @@ real intersectSphere(uint index, rvec3 origin, real originLength, rvec3 dir, uin
 // Word i of the BVH's nodes, through whichever the driver reads faster: the
 // texel view or the buffer's device address (shared_layout.h).
 uvec4 bvhWord(int i) {
-    if (BVH_WORDS) return BvhWords(uvec2(frame.bvhAddressLow, frame.bvhAddressHigh)).words[i];
+    if (BVH_WORDS) return fromHalves(BvhWords(uvec2(frame.bvhAddressLow, frame.bvhAddressHigh)).words[i]);
     return texelFetch(bvhTexels, i);
 }
 
@@ -402,11 +405,24 @@ layout(constant_id = SNELL_SPEC_STACKS_BY_ADDRESS) const bool STACKS_BY_ADDRESS 
 #define pendingRays() PendingRays(uvec2(frame.rayStackAddressLow, frame.rayStackAddressHigh))
 #define mediaEntries() MediaEntries(uvec2(frame.mediaStackAddressLow, frame.mediaStackAddressHigh))
 void storePending(uint entry, PendingRay p) {
-    if (STACKS_BY_ADDRESS) pendingRays().rays[entry] = p;
-    else rayStack[entry] = p;
+    if (STACKS_BY_ADDRESS) {
+        uint w = 4u * entry;
+        pendingRays().words[w] = toHalves(floatBitsToUint(p.origin));
+        pendingRays().words[w + 1u] = toHalves(floatBitsToUint(p.direction));
+        pendingRays().words[w + 2u] = toHalves(floatBitsToUint(p.weight));
+        pendingRays().words[w + 3u] = toHalves(uvec4(p.depth, p.fromSphere, p.flags, p.resumeShading));
+    } else {
+        rayStack[entry] = p;
+    }
 }
 PendingRay loadPending(uint entry) {
-    if (STACKS_BY_ADDRESS) return pendingRays().rays[entry];
+    if (STACKS_BY_ADDRESS) {
+        uint w = 4u * entry;
+        uvec4 last = fromHalves(pendingRays().words[w + 3u]);
+        return PendingRay(uintBitsToFloat(fromHalves(pendingRays().words[w])),
+                          uintBitsToFloat(fromHalves(pendingRays().words[w + 1u])),
+                          uintBitsToFloat(fromHalves(pendingRays().words[w + 2u])), last.x, last.y, last.z, last.w);
+    }
     return rayStack[entry];
 }
 void storeMedium(uint i, uint sphere) {

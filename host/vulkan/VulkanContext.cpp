@@ -153,6 +153,11 @@ DeviceReport examine(VkPhysicalDevice device, int index, std::uint32_t& family,
         report.reason = "lacks the bufferDeviceAddress feature (Vulkan 1.2, required from 1.3)";
         return report;
     }
+    if (!features.features.shaderInt64) {
+        // The kernel moves 16-byte words through addresses as 64-bit halves.
+        report.reason = "lacks the shaderInt64 feature";
+        return report;
+    }
     VkFormatProperties format;
     vkGetPhysicalDeviceFormatProperties(device, VK_FORMAT_R32G32B32A32_SFLOAT, &format);
     if (!(format.optimalTilingFeatures & VK_FORMAT_FEATURE_STORAGE_IMAGE_BIT)) {
@@ -406,6 +411,7 @@ void Context::createDevice(const std::vector<std::string>& extensions, RayQuerie
     VkPhysicalDeviceFeatures2 enabled{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2};
     float64_ = supported.shaderFloat64;
     enabled.features.shaderFloat64 = supported.shaderFloat64;
+    enabled.features.shaderInt64 = VK_TRUE;  // every device snell uses has it (examine)
     VkPhysicalDeviceRayQueryFeaturesKHR rayQuery{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_RAY_QUERY_FEATURES_KHR};
     VkPhysicalDeviceAccelerationStructureFeaturesKHR accel{
         VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_ACCELERATION_STRUCTURE_FEATURES_KHR, &rayQuery};
