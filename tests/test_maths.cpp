@@ -1,13 +1,11 @@
-// Transforms (SPEC §2), ray–sphere intersection and Snell's law (SPEC §4–5),
-// and one CPU-rendered pixel computed by hand.
+// Transforms (SPEC §2), ray–sphere intersection and Snell's law (SPEC §4–5).
+// The CPU renderer's pixels by hand are in test_cpu_renderer.cpp.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <numbers>
 
-#include "reference/CpuRenderer.h"
 #include "reference/Intersect.h"
-#include "render/RenderRequest.h"
 #include "scene/Parser.h"
 #include "scene/Transform.h"
 
@@ -262,73 +260,6 @@ TEST(Refraction, ReflectDirectionByHand) {
     expectNear(snell::reflectDirection({1, 0, 0}, glm::normalize(dvec3(-1, 1, 0))), {0, 1, 0}, 1e-15);
     // Grazing: tangent direction is unchanged.
     expectNear(snell::reflectDirection({1, 0, 0}, {0, 1, 0}), {1, 0, 0});
-}
-
-// ---------------------------------------------------------------- CPU renderer
-
-snell::RenderRequest requestFor(const snell::Scene& s) {
-    snell::RenderRequest r;
-    r.camera = snell::Camera::fromSpec(s.imageSize, s.halfWidth);
-    r.width = r.height = s.imageSize;
-    r.supersample = s.supersample;
-    r.trace = snell::kReferenceSettings;
-    r.threads = 1;
-    return r;
-}
-
-TEST(CpuRenderer, DiffusePixelByHand) {
-    // Hit at (0,0,-2), N = (0,0,1), L = normalize((0,0,10) - (0,0,-2)) = (0,0,1):
-    // C = kd (N.L) = 0.5.
-    const snell::Scene s = parse("view 1 1\nmove 0 0 -3\nmaterial 0.5 0.5 0.5 0 0 0 1\nsphere\n"
-                                 "light 1 1 1 0 0 10\nambient 0 0 0\n");
-    const snell::CpuRenderer renderer(s);
-    const snell::RenderRequest req = requestFor(s);
-    const snell::Image image = renderer.render(req);
-    ASSERT_EQ(image.width, 1);
-    ASSERT_EQ(image.height, 1);
-    for (int k = 0; k < 3; ++k) EXPECT_NEAR(image.pixel(0, 0)[k], 0.5f, 1e-6f);
-    snell::RayCounts counts;
-    const dvec3 c = renderer.renderPixel(req, 0, 0, counts).colour;
-    expectNear(c, dvec3(0.5), 1e-12);
-    EXPECT_EQ(counts.primary, 1u);
-    EXPECT_EQ(counts.shadow, 1u);
-}
-
-TEST(CpuRenderer, ObliqueLightAmbientAndBackground) {
-    // Light at (3,0,-2): L from (0,0,-2) is (1,0,0), N.L = 0: only ambient.
-    // A second light at (0,4,1): L = normalize(0,4,3) = (0,0.8,0.6), N.L = 0.6.
-    const snell::Scene s = parse("view 3 1\nbackground 0.1 0.2 0.3\nambient 0.2 0.4 0.6\n"
-                                 "move 0 0 -3\nmaterial 0.5 0.25 1 0 0 0 1\nsphere\n"
-                                 "light 1 1 1 3 0 -2\nlight 1 0.5 2 0 4 1\n");
-    const snell::CpuRenderer renderer(s);
-    const snell::RenderRequest req = requestFor(s);
-    const snell::Image image = renderer.render(req);
-    // Centre pixel (1,1): ray straight down -z.
-    const dvec3 kd(0.5, 0.25, 1.0);
-    const dvec3 expected = dvec3(0.2, 0.4, 0.6) * kd + dvec3(1, 0.5, 2) * kd * 0.6;
-    for (int k = 0; k < 3; ++k) EXPECT_NEAR(image.pixel(1, 1)[k], expected[k], 1e-6) << k;
-    // Corner pixel (0,0): direction normalize(-2/3, 2/3, -1) misses: background.
-    for (int k = 0; k < 3; ++k) EXPECT_NEAR(image.pixel(0, 0)[k], 0.1f * (k + 1), 1e-7f) << k;
-}
-
-TEST(CpuRenderer, SpecularAndReflectionByHand) {
-    // R = 2(N.L)N - L = (0,0,1) = V: specular ks (R.V)^p = 0.25. The reflected
-    // ray (0,0,1) leaves the scene: + ks * background = 0.25 * 0.2.
-    const snell::Scene s = parse("view 1 1\nbackground 0.2 0.2 0.2\nmove 0 0 -3\n"
-                                 "material 0.5 0.5 0.5 0.25 0.25 0.25 10\nsphere\nlight 1 1 1 0 0 10\n");
-    const snell::CpuRenderer renderer(s);
-    const snell::Image image = renderer.render(requestFor(s));
-    for (int k = 0; k < 3; ++k) EXPECT_NEAR(image.pixel(0, 0)[k], 0.5 + 0.25 + 0.25 * 0.2, 1e-6);
-}
-
-TEST(CpuRenderer, ShadowFromSphereBehindTheEye) {
-    // A sphere at z = 5 is behind the eye (not seen) but blocks the light.
-    const snell::Scene s = parse("view 1 1\nbackground 0.3 0.3 0.3\nambient 0.1 0.1 0.1\n"
-                                 "group\nmove 0 0 -3\nmaterial 0.5 0.5 0.5 0 0 0 1\nsphere\ngroupend\n"
-                                 "move 0 0 5\nsphere\nlight 1 1 1 0 0 10\n");
-    const snell::CpuRenderer renderer(s);
-    const snell::Image image = renderer.render(requestFor(s));
-    for (int k = 0; k < 3; ++k) EXPECT_NEAR(image.pixel(0, 0)[k], 0.1 * 0.5, 1e-7);
 }
 
 }  // namespace
