@@ -94,5 +94,8 @@ if [ "$codename" = bookworm ]; then
   fi
 fi
 
-cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DSNELL_SECOND_LAVAPIPE_ICD="$second_icd" >/dev/null
+# ccache where present (a fresh machine has none; nothing needs it).
+launcher=()
+command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release -DSNELL_SECOND_LAVAPIPE_ICD="$second_icd" "${launcher[@]}" >/dev/null
 cmake --build build --parallel
