@@ -6,6 +6,8 @@
 // interleaved tiles). Where the device cannot take a path a test names, the
 // test is skipped saying why, and fails under CI (gpu_test_support.h).
 #include <algorithm>
+#include <cctype>
+#include <filesystem>
 #include <functional>
 #include <initializer_list>
 #include <string>
@@ -32,22 +34,33 @@ using snell::testing::wholeImage;
 // however often it suspends: mid-tree with nested media (glass), deep
 // amplifying trees (becker-1n), mid-way through the lights (256-lights), in
 // the BVH (grid), with supersampling (showcase).
-TEST(GpuResume, SuspendingNeverChangesTheImage) {
-    for (const char* file : {SNELL_SOURCE_DIR "/scenes/glass.scn", SNELL_SHARED_DIR "/course-scenes/becker-1n.scn",
-                             SNELL_SOURCE_DIR "/scenes/hard/256-lights.scn", SNELL_SOURCE_DIR "/scenes/grid.scn",
-                             SNELL_SOURCE_DIR "/scenes/showcase.scn"}) {
-        SCOPED_TRACE(file);
-        const snell::Scene scene = snell::parseSceneFile(file);
-        const snell::RenderRequest request = wholeImage(scene, 40);
-        snell::ComputeRenderer gpu(context(), scene, request.camera);
-        const snell::GpuRenderResult whole = gpu.render(request, false);
-        gpu.forceLoopBudget(48);
-        const snell::GpuRenderResult resumed = gpu.render(request, false);
-        EXPECT_GT(resumed.dispatches, 2 * whole.dispatches) << "the budget forced too few suspensions to test";
-        EXPECT_EQ(resumed.image.rgb, whole.image.rgb);
-    }
+class GpuResume : public testing::TestWithParam<const char*> {};
+
+TEST_P(GpuResume, SuspendingNeverChangesTheImage) {
+    const snell::Scene scene = snell::parseSceneFile(GetParam());
+    const snell::RenderRequest request = wholeImage(scene, 40);
+    snell::ComputeRenderer gpu(context(), scene, request.camera);
+    const snell::GpuRenderResult whole = gpu.render(request, false);
+    gpu.forceLoopBudget(48);
+    const snell::GpuRenderResult resumed = gpu.render(request, false);
+    EXPECT_GT(resumed.dispatches, 2 * whole.dispatches) << "the budget forced too few suspensions to test";
+    EXPECT_EQ(resumed.image.rgb, whole.image.rgb);
 }
 
+// A scene file's stem, as a test's name.
+std::string stemOf(const std::string& file) {
+    std::string n = std::filesystem::path(file).stem().string();
+    for (char& c : n)
+        if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+    return n;
+}
+
+INSTANTIATE_TEST_SUITE_P(Scenes, GpuResume,
+                         testing::Values(SNELL_SOURCE_DIR "/scenes/glass.scn",
+                                         SNELL_SHARED_DIR "/course-scenes/becker-1n.scn",
+                                         SNELL_SOURCE_DIR "/scenes/hard/256-lights.scn",
+                                         SNELL_SOURCE_DIR "/scenes/grid.scn", SNELL_SOURCE_DIR "/scenes/showcase.scn"),
+                         [](const testing::TestParamInfo<const char*>& info) { return stemOf(info.param); });
 
 // What the progress bar's estimate takes from the renderer: each pixel's rays
 // (its closest-hit queries: the rays the progress reports, but for the shadow
@@ -172,46 +185,55 @@ TEST(GpuTiles, InterleavedTilesGiveTheImageOfBlocks) {
 // one dispatch to the next; nested media (glass in water), amplifying trees
 // (becker-1n), a BVH, the fp64 kernel (its low parts stay in a storage
 // buffer), and the deepest stack of a fixed tree without a cut-off.
-TEST(GpuStacks, AddressesTraceTheStorageBuffersImage) {
-    struct Case {
-        const char* file;
-        snell::gpu::Precision precision;
-        bool fixedTree;  // --depth 5 --min-weight 0 --tolerance 0 (POV-Ray's settings)
-    };
-    const Case cases[] = {{SNELL_SOURCE_DIR "/scenes/glass.scn", snell::gpu::Precision::Fp32, false},
-                          {SNELL_SOURCE_DIR "/scenes/glass.scn", snell::gpu::Precision::Fp64, false},
-                          {SNELL_SOURCE_DIR "/scenes/hard/glass-in-water-gap-0.scn", snell::gpu::Precision::Fp32, false},
-                          {SNELL_SHARED_DIR "/course-scenes/becker-1n.scn", snell::gpu::Precision::Fp32, false},
-                          {SNELL_SOURCE_DIR "/scenes/grid.scn", snell::gpu::Precision::Fp32, false},
-                          {SNELL_SHARED_DIR "/bench-scenes/glass.scn", snell::gpu::Precision::Fp32, true}};
-    for (const Case& c : cases) {
-        const bool wide = c.precision == snell::gpu::Precision::Fp64;
-        SCOPED_TRACE(std::string(c.file) + (wide ? " fp64" : " fp32") + (c.fixedTree ? ", fixed tree" : ""));
-        if (wide && !context().float64Supported()) continue;
-        const snell::Scene scene = snell::parseSceneFile(c.file);
-        snell::RenderRequest request = wholeImage(scene, 48);
-        if (c.fixedTree) {
-            request.trace.maxDepth = 5;
-            request.trace.minWeight = 0.0;
-            request.trace.tolerance = 0.0;
-        }
-        std::vector<snell::Image> images;
-        for (const bool byAddress : {false, true}) {
-            snell::ComputeRenderer renderer(context(), scene, request.camera, c.precision);
-            renderer.addressStacks(byAddress);
-            const snell::GpuRenderResult whole = renderer.render(request, false);
-            EXPECT_EQ(renderer.kernelAddressedStacks(), byAddress);
-            renderer.forceLoopBudget(48);
-            const snell::GpuRenderResult resumed = renderer.render(request, false);
-            EXPECT_GT(resumed.dispatches, 2 * whole.dispatches) << "the budget forced too few suspensions to test";
-            ASSERT_EQ(whole.image.rgb.size(), std::size_t(3 * 48 * 48));
-            ASSERT_EQ(resumed.image.rgb.size(), whole.image.rgb.size());
-            EXPECT_EQ(pixelsThatDiffer(whole.image, resumed.image), 0u) << "pixels that differ once suspended";
-            images.push_back(whole.image);
-        }
-        EXPECT_EQ(pixelsThatDiffer(images[0], images[1]), 0u) << "pixels that differ between the stacks";
+struct StackCase {
+    const char* name;
+    const char* file;
+    snell::gpu::Precision precision;
+    bool fixedTree;  // --depth 5 --min-weight 0 --tolerance 0 (POV-Ray's settings)
+};
+
+class GpuStacks : public testing::TestWithParam<StackCase> {};
+
+TEST_P(GpuStacks, AddressesTraceTheStorageBuffersImage) {
+    const StackCase& c = GetParam();
+    if (c.precision == snell::gpu::Precision::Fp64 && !context().float64Supported())
+        SNELL_CANNOT_TEST_HERE("this device has no shader doubles");
+    const snell::Scene scene = snell::parseSceneFile(c.file);
+    snell::RenderRequest request = wholeImage(scene, 48);
+    if (c.fixedTree) {
+        request.trace.maxDepth = 5;
+        request.trace.minWeight = 0.0;
+        request.trace.tolerance = 0.0;
     }
+    std::vector<snell::Image> images;
+    for (const bool byAddress : {false, true}) {
+        snell::ComputeRenderer renderer(context(), scene, request.camera, c.precision);
+        renderer.addressStacks(byAddress);
+        const snell::GpuRenderResult whole = renderer.render(request, false);
+        EXPECT_EQ(renderer.kernelAddressedStacks(), byAddress);
+        renderer.forceLoopBudget(48);
+        const snell::GpuRenderResult resumed = renderer.render(request, false);
+        EXPECT_GT(resumed.dispatches, 2 * whole.dispatches) << "the budget forced too few suspensions to test";
+        ASSERT_EQ(whole.image.rgb.size(), std::size_t(3 * 48 * 48));
+        ASSERT_EQ(resumed.image.rgb.size(), whole.image.rgb.size());
+        EXPECT_EQ(pixelsThatDiffer(whole.image, resumed.image), 0u) << "pixels that differ once suspended";
+        images.push_back(whole.image);
+    }
+    EXPECT_EQ(pixelsThatDiffer(images[0], images[1]), 0u) << "pixels that differ between the stacks";
 }
+
+INSTANTIATE_TEST_SUITE_P(
+    Scenes, GpuStacks,
+    testing::Values(StackCase{"glass", SNELL_SOURCE_DIR "/scenes/glass.scn", snell::gpu::Precision::Fp32, false},
+                    StackCase{"glass_fp64", SNELL_SOURCE_DIR "/scenes/glass.scn", snell::gpu::Precision::Fp64, false},
+                    StackCase{"glass_in_water_gap_0", SNELL_SOURCE_DIR "/scenes/hard/glass-in-water-gap-0.scn",
+                              snell::gpu::Precision::Fp32, false},
+                    StackCase{"becker_1n", SNELL_SHARED_DIR "/course-scenes/becker-1n.scn",
+                              snell::gpu::Precision::Fp32, false},
+                    StackCase{"grid", SNELL_SOURCE_DIR "/scenes/grid.scn", snell::gpu::Precision::Fp32, false},
+                    StackCase{"bench_glass_fixed_tree", SNELL_SHARED_DIR "/bench-scenes/glass.scn",
+                              snell::gpu::Precision::Fp32, true}),
+    [](const testing::TestParamInfo<StackCase>& info) { return std::string(info.param.name); });
 
 // The shadow rays of a subgroup's hits are walked by all its lanes, or each
 // by its own lane in the lights' loop (trace.comp, shadeLightsShared): both
