@@ -1,8 +1,8 @@
 // How the workgroups of a tile run, for the compute renderer: which share of
 // the tile each takes, and how long a tile in progress has left. The
 // compute renderer deals each workgroup its own pixels
-// (shaders/schedule/pixels.glsl, takePixel), and a device runs a few workgroups at once, each to its end:
-// lavapipe one a thread, in order. So the tile ends when its last workgroup
+// (shaders/schedule/pixels.glsl, takePixel), and a device runs a few
+// workgroups at once, each to its end: lavapipe one a thread, in order. So the tile ends when its last workgroup
 // does, and near its end fewer workgroups than executors are left and the
 // tile slows: a tail that neither the pixels finished nor the cost done
 // foresees, and the forecast below does.
