@@ -1,3 +1,4 @@
+// The camera ray of a sub-pixel sample (SPEC §3).
 #ifndef SNELL_PHYSICS_CAMERA_GLSL
 #define SNELL_PHYSICS_CAMERA_GLSL
 

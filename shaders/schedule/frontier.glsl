@@ -4,11 +4,9 @@
 #ifndef SNELL_SCHEDULE_FRONTIER_GLSL
 #define SNELL_SCHEDULE_FRONTIER_GLSL
 
-// cutOff: that of the pixel in hand, the minimum weight or, under a
-// tolerance, the one its current step uses (SlotState.cutOff). (The
-// per-pixel values live in main's locals and are passed down: Mesa 22.3's
-// llvmpipe keeps memory for every dispatch of a shader with such private
-// globals, tests/soak_test.sh.)
+// Whether a ray of weight w is traced under cutOff: that of the pixel in
+// hand, the minimum weight or, under a tolerance, the one its current step
+// uses (SlotState.cutOff).
 bool worthTracing(vec3 w, float cutOff) {
     float m = max(w.x, max(w.y, w.z));
     return m > 0.0 && m >= cutOff;
