@@ -94,10 +94,10 @@ using uint = std::uint32_t;
 #define SNELL_SPEC_FRONTIER 15
 #define SNELL_SPEC_COUNT_LANES 16  // count the SIMD lanes busy in each loop pass (render --count-lanes)
 #define SNELL_SPEC_TRAPS 17        // some material traps light (render/Truncation.h, growthTraps)
-#define SNELL_SPEC_HELPS 18        // workgroups help with each other's shares of a tile (trace.comp, takePixel)
+#define SNELL_SPEC_HELPS 18        // workgroups help with each other's shares of a tile (schedule/pixels.glsl, takePixel)
 #define SNELL_SPEC_BVH_WORDS 19    // the walk reads the BVH's nodes through their address (FrameParams.bvhAddress)
-#define SNELL_SPEC_STACK_IN_REGISTERS 20  // the walk's stack in registers (trace.comp, pushEntry)
-#define SNELL_SPEC_SHARE_SHADOW_RAYS 21  // a subgroup's shadow rays walked by all its lanes (trace.comp, shadeLightsShared)
+#define SNELL_SPEC_STACK_IN_REGISTERS 20  // the walk's stack in registers (bvh_walk.glsl, pushEntry)
+#define SNELL_SPEC_SHARE_SHADOW_RAYS 21  // a subgroup's shadow rays walked by all its lanes (schedule/lights.glsl, shadeLightsShared)
 #define SNELL_SPEC_LIGHTS_IN_FRAME 22  // the lights are read from FrameParams.lights
 #define SNELL_SPEC_STACKS_BY_ADDRESS 23  // the ray and media stacks through their addresses (FrameParams.rayStackAddress)
 #define SNELL_SPEC_COUNT 24
@@ -126,7 +126,7 @@ using uint = std::uint32_t;
 #define SNELL_COUNTER_COUNT 13
 // After them, for workgroup w at SNELL_COUNTER_COUNT + w · SNELL_COUNTER_STRIDE
 // (a cache line each), the pixels of its share of the tile its invocations
-// have taken after their first (trace.comp, takePixel); kept across the
+// have taken after their first (schedule/pixels.glsl, takePixel); kept across the
 // dispatches that resume a tile. After those, a bit a share, set while it
 // may have pixels left, and then a bit a word of those, set while the word is
 // not 0 (the host sets them all at the tile's first dispatch).
@@ -345,7 +345,7 @@ struct TileParams {
     uint height;
     uint resume;
     // Workgroup g takes share (g · workgroupStride) mod W of the tile's W
-    // shares of pixels (trace.comp, takePixel); coprime with W.
+    // shares of pixels (schedule/pixels.glsl, takePixel); coprime with W.
     uint workgroupStride;
     uint strideX;
     uint strideY;

@@ -4,7 +4,9 @@
 # every subcommand `snell --help` lists, no builder's paths, and renders
 # without warnings; the bash completion offers every subcommand;
 # docs/scene-format.md names every command of the scene format and its
-# example scene parses; and the man page's example commands run.
+# example scene parses; every file and symbol that README.md and docs/*.md
+# name in backticks exists (tests/docs_names.py); and the man page's example
+# commands run.
 #   SNELL=build/snell DOCS=build/docs SOURCE=. bash tests/docs_test.sh
 set -u
 : "${SNELL:?}" "${DOCS:?}" "${SOURCE:?}"
@@ -96,6 +98,23 @@ if [ -s "$format_doc" ]; then
 else
   bad "no docs/scene-format.md"
 fi
+
+# Every file and symbol the docs name exists: one FAIL a missing name, with
+# the doc and its line; and enough names are recognised that the check is one.
+names=$(python3 "$SOURCE/tests/docs_names.py" "$SOURCE" 2>&1)
+status=$?
+summary=$(printf '%s\n' "$names" | tail -n 1)
+echo "$summary"
+if [ $status -eq 0 ]; then ok
+elif [ $status -eq 1 ]; then
+  while IFS= read -r line; do bad "$line"; done < <(printf '%s\n' "$names" | sed '$d')
+else
+  bad "tests/docs_names.py exited with $status: $names"
+fi
+checked=$(printf '%s\n' "$summary" | sed -n 's/.* \([0-9]*\) paths and \([0-9]*\) names checked.*/\1 \2/p')
+read -r paths_checked names_checked <<<"${checked:-0 0}"
+[ "$paths_checked" -ge 100 ] && [ "$names_checked" -ge 10 ] && ok ||
+  bad "tests/docs_names.py recognised only ${paths_checked:-0} paths and ${names_checked:-0} names"
 
 # The EXAMPLES section's commands run, in order, in an empty directory where
 # each scene they name is a small one (a window and a benchmark are left out).

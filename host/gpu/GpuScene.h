@@ -52,7 +52,7 @@ enum class Precision { Fp32, Fp64 };
 inline constexpr std::size_t kBvhThreshold = SNELL_MAX_UNROLLED_SPHERES;
 // Whether to build and traverse a BVH: by that threshold, or forced (the bench).
 enum class BvhMode { Auto, Off, On };
-// How a BVH scene is searched: snell's own walk (trace.comp, traverseBvh), or
+// How a BVH scene is searched: snell's own walk (physics/hit.glsl, traverseBvh), or
 // the device's ray traversal (VK_KHR_ray_query over the spheres' boxes), or
 // the device's where it is enabled (vk::ContextOptions::rayQueries).
 enum class Traversal { Auto, Walk, RayQuery };

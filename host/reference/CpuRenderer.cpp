@@ -59,6 +59,19 @@ void addWeighted(dvec3& sum, const dvec3& weight, const dvec3& colour) { sum += 
 constexpr double kMaxWeight = 1e30;
 dvec3 childWeight(const dvec3& weight, const dvec3& gain) { return glm::min(weighted(weight, gain), dvec3(kMaxWeight)); }
 
+// The gain of a hit's children together: ks reflected, kt transmitted.
+dvec3 childrenGain(const Material& m, const TraceSettings& settings) {
+    const dvec3 reflectedGain = settings.reflection ? m.ks : dvec3(0.0);
+    const dvec3 transmittedGain = settings.refraction && m.refracts() ? m.kt : dvec3(0.0);
+    return reflectedGain + transmittedGain;
+}
+
+// Whether a ray of weight w is traced under the cut-off.
+bool worthTracing(const dvec3& w, double cutOff) {
+    const double m = maxComponent(w);
+    return m > 0.0 && m >= cutOff;
+}
+
 // A ray refracted at a surface of `sphere` (material m), entering it or
 // leaving: the refractive index of the medium it leaves over that of the one
 // it enters (SPEC §4.5), and `media` becomes the refracted ray's medium stack.
@@ -92,9 +105,14 @@ bool rayHitsBox(const Aabb& box, const dvec3& origin, const dvec3& inverseDir, d
 
 }  // namespace
 
+// Where a ray met its closest surface, and what shading needs there.
 struct CpuRenderer::Hit {
     double t = kNoHit;
     std::uint32_t sphere = kNone;
+    const Material* material = nullptr;
+    dvec3 point{0.0};
+    dvec3 normal{0.0};         // the shading normal N (against the ray)
+    bool fromOutside = false;  // the ray arrived from outside the sphere
 };
 
 struct CpuRenderer::PendingRay {
@@ -105,6 +123,13 @@ struct CpuRenderer::PendingRay {
     bool inward = false;               // it starts into that sphere
     bool refracted = false;
     MediumStack media;
+};
+
+// One hit's children: the reflected ray, and the refracted one unless total
+// internal reflection (or no refraction) leaves none.
+struct CpuRenderer::Children {
+    PendingRay reflected;
+    std::optional<PendingRay> refracted;
 };
 
 // What a pixel's trees did not trace so far (render/Truncation.h): the weight
@@ -234,13 +259,17 @@ bool CpuRenderer::occluded(const Ray& ray, double distance, std::uint32_t fromSp
     return false;
 }
 
-// The ray tree (SPEC §4) below `root` (a camera ray, or a ray an earlier
-// cut-off left), depth first with an explicit stack, adding each ray's local
-// term straight into pixelSum. A channel whose pixel sum has reached
-// `saturation` is final in 8 bits (SPEC §4 "amplifying materials"), so its
-// weight is dropped from then on. A ray under the cut-off waits in
-// tree.frontier for a lower one; one that the depth limit or the budget stops
-// is lost (render/Truncation.h).
+// SPEC §3: sub-pixel sample k = b·s + a of pixel (x, y): the ray through
+// (x + (a + ½)/s, y + (b + ½)/s), from the eye.
+CpuRenderer::PendingRay CpuRenderer::cameraRay(const Camera& camera, int s, int x, int y, int k) {
+    const int a = k % s, b = k / s;
+    const double px = x + (a + 0.5) / s;
+    const double py = y + (b + 0.5) / s;
+    PendingRay primary;
+    primary.ray = {camera.eye, camera.direction(px, py)};
+    return primary;
+}
+
 // The outward normal No of `sphere` at the point o + t d of `ray` (an
 // ellipsoid's through its object frame: the transposed inverse map).
 dvec3 CpuRenderer::outwardNormal(const Sphere& sphere, const Ray& ray, double t) const {
@@ -250,84 +279,138 @@ dvec3 CpuRenderer::outwardNormal(const Sphere& sphere, const Ray& ray, double t)
     return glm::normalize(glm::transpose(glm::dmat3(sphere.objectFromWorld)) * p);
 }
 
-// The local Phong term at x on sphere `hitSphere`, with shading normal n,
-// seen from v: ambient, then each light in order, with binary shadows
-// (SPEC §4.3).
-dvec3 CpuRenderer::localTerm(const Material& m, std::uint32_t hitSphere, const dvec3& x, const dvec3& n,
-                              const dvec3& v, bool fromOutside, const TraceSettings& settings,
-                              RayCounts& counts) const {
-    dvec3 local = scene_.ambient * m.kd;
+// 1–2. The closest hit of ray r (SPEC §4.1), and what shading needs there:
+// the material, the point, and the shading normal N. False on a miss.
+bool CpuRenderer::findHit(const PendingRay& r, Hit& hit) const {
+    const StartsOn start = r.inward ? StartsOn::Entering : StartsOn::Leaving;
+    if (!closestHit(r.ray, r.fromSphere, start, hit)) return false;
+    const Sphere& sphere = scene_.spheres[hit.sphere];
+    hit.material = &scene_.materials[sphere.material];
+    // The hit point is o + t d, not re-projected (shaders/physics/hit.glsl says why).
+    hit.point = r.ray.origin + hit.t * r.ray.direction;
+    const dvec3 outward = outwardNormal(sphere, r.ray, hit.t);
+    hit.fromOutside = glm::dot(r.ray.direction, outward) < 0.0;
+    hit.normal = hit.fromOutside ? outward : -outward;
+    return true;
+}
+
+// 3. The ambient part of the local term at a hit (SPEC §4.3).
+dvec3 CpuRenderer::ambientTerm(const Hit& hit) const { return scene_.ambient * hit.material->kd; }
+
+// Light's part of the local term at a hit, seen from v, with a binary shadow
+// (SPEC §4.3); castShadowRay: a shadow ray was cast (the surface faces the light).
+dvec3 CpuRenderer::shadeLight(const Light& light, const Hit& hit, const dvec3& v, const TraceSettings& settings,
+                              bool& castShadowRay) const {
+    castShadowRay = false;
+    dvec3 l = light.position - hit.point;
+    const double distance = glm::length(l);
+    l /= distance;
+    const double nl = glm::dot(hit.normal, l);
+    if (!(nl > 0.0)) return dvec3(0.0);
+    castShadowRay = settings.shadows;
+    // A shadow ray towards N's side enters the sphere only when N = −No.
+    const StartsOn start = hit.fromOutside ? StartsOn::Leaving : StartsOn::Entering;
+    if (settings.shadows && occluded({hit.point, l}, distance, hit.sphere, start)) return dvec3(0.0);
+    const Material& m = *hit.material;
+    const dvec3 reflectedLight = 2.0 * nl * hit.normal - l;
+    const double rv = glm::dot(reflectedLight, v);
+    const double specular = rv > 0.0 ? std::pow(rv, m.phong) : 0.0;
+    return light.colour * (m.kd * nl + m.ks * specular);
+}
+
+// The whole local term: ambient, then each light in order. (The shader adds
+// each part to the pixel as it goes, so that a dispatch may stop between
+// lights: the same terms, summed in another order.)
+dvec3 CpuRenderer::localTerm(const Hit& hit, const dvec3& v, const TraceSettings& settings,
+                             RayCounts& counts) const {
+    dvec3 local = ambientTerm(hit);
     for (const Light& light : scene_.lights) {
-        dvec3 l = light.position - x;
-        const double distance = glm::length(l);
-        l /= distance;
-        const double nl = glm::dot(n, l);
-        if (!(nl > 0.0)) continue;
-        if (settings.shadows) ++counts.shadow;
-        // A shadow ray towards N's side enters the sphere only when N = −No.
-        if (settings.shadows &&
-            occluded({x, l}, distance, hitSphere, fromOutside ? StartsOn::Leaving : StartsOn::Entering))
-            continue;
-        const dvec3 reflectedLight = 2.0 * nl * n - l;
-        const double rv = glm::dot(reflectedLight, v);
-        const double specular = rv > 0.0 ? std::pow(rv, m.phong) : 0.0;
-        local += light.colour * (m.kd * nl + m.ks * specular);
+        bool castShadowRay = false;
+        const dvec3 term = shadeLight(light, hit, v, settings, castShadowRay);
+        if (castShadowRay) ++counts.shadow;
+        local += term;
     }
     return local;
 }
 
-// 4–5. The children of ray r at its hit on sphere `hitSphere` (material m,
-// point x, shading normal n): reflection (keeping the medium stack) and
-// refraction (SPEC §4.5), each traced (on `stack`) or, under the cut-off,
-// deferred to a lower one; weight the depth limit stops is lost
-// (render/Truncation.h). trace.comp's spawnChildren is its twin.
-void CpuRenderer::spawnChildren(const PendingRay& r, const Material& m, std::uint32_t hitSphere, const dvec3& x,
-                                const dvec3& n, bool fromOutside, double cutOff, const TraceSettings& settings,
-                                TreeTrace& tree, std::vector<PendingRay>& stack) const {
+// 4–5. The children of ray r at a hit (SPEC §4.4, §4.5): the reflected ray,
+// keeping the medium stack, and the refracted ray by Snell's law, unless
+// total internal reflection folds its weight into the reflected one.
+CpuRenderer::Children CpuRenderer::children(const PendingRay& r, const Hit& hit,
+                                            const TraceSettings& settings) const {
+    const Material& m = *hit.material;
     const dvec3 d = r.ray.direction;
-    auto worthTracing = [&](const dvec3& w) {
-        const double mw = maxComponent(w);
-        return mw > 0.0 && mw >= cutOff;
-    };
-    auto defer = [&](PendingRay&& child) { tree.defer(std::move(child), settings); };
-    const dvec3 reflectedGain = settings.reflection ? m.ks : dvec3(0.0);
-    const dvec3 transmittedGain = settings.refraction && m.refracts() ? m.kt : dvec3(0.0);
+    Children c;
+    dvec3 reflectedWeight = childWeight(r.weight, settings.reflection ? m.ks : dvec3(0.0));
+    if (settings.refraction && m.refracts()) {
+        const dvec3 transmittedWeight = childWeight(r.weight, m.kt);
+        MediumStack media = r.media;
+        const double eta = crossSurface(scene_, hit.fromOutside, m, hit.sphere, media);
+        dvec3 refracted;
+        if (!refractDirection(d, hit.normal, eta, refracted)) {
+            // Total internal reflection is the reflected ray in the same
+            // medium: one ray carrying both weights (exactly SPEC §4.5).
+            reflectedWeight = glm::min(reflectedWeight + transmittedWeight, dvec3(kMaxWeight));
+        } else {
+            c.refracted = PendingRay{{hit.point, refracted}, transmittedWeight, r.depth + 1, hit.sphere,
+                                     hit.fromOutside, true, media};
+        }
+    }
+    c.reflected = PendingRay{{hit.point, reflectDirection(d, hit.normal)}, reflectedWeight, r.depth + 1, hit.sphere,
+                             !hit.fromOutside, false, r.media};
+    return c;
+}
+
+// Ray r of a tree, before its closest hit: the channels whose pixel sum has
+// reached `saturation` are final in 8 bits (SPEC §4 amplifying materials) and
+// dropped; under the cut-off it waits in tree.frontier for a lower one; past
+// the tree budget it is lost (render/Truncation.h). Else it is traced.
+bool CpuRenderer::admitRay(PendingRay& r, const dvec3& pixelSum, double saturation, double cutOff,
+                           const TraceSettings& settings, RayCounts& counts, TreeTrace& tree) const {
+    for (int k = 0; k < 3; ++k)
+        if (pixelSum[k] >= saturation) r.weight[k] = 0.0;
+    if (!worthTracing(r.weight, cutOff)) {
+        tree.defer(std::move(r), settings);
+        return false;
+    }
+    if (tree.budget != 0 && tree.rays >= tree.budget) {
+        tree.overBudget = true;
+        tree.lost += r.weight;
+        return false;
+    }
+    ++tree.rays;
+    tree.deepest = std::max(tree.deepest, r.depth);
+    if (r.depth > 0) ++(r.refracted ? counts.refracted : counts.reflected);
+    return true;
+}
+
+// What becomes of the children of ray r at a hit: the depth limit loses
+// their weight (render/Truncation.h); under the cut-off a child waits in
+// tree.frontier; the others go on `stack`, the one traced next last.
+void CpuRenderer::followChildren(const PendingRay& r, const Hit& hit, double cutOff, const TraceSettings& settings,
+                                 TreeTrace& tree, std::vector<PendingRay>& stack) const {
+    const dvec3 gain = childrenGain(*hit.material, settings);
     if (r.depth >= settings.maxDepth) {
-        tree.lost += weighted(r.weight, reflectedGain + transmittedGain);
+        tree.lost += weighted(r.weight, gain);
         return;
     }
-
     // Light carried into a material that traps it (SPEC §4 amplifying
     // materials; growthTraps: an orbit of total internal reflection that
     // gains at every bounce) grows until its channel saturates, and a path of
     // tiny weight that enters one does too. The pixel's series may diverge
     // behind steps that seem to settle, so its estimated error must be within
     // kAmplifiedEstimate and it goes on below the floor (renderPixel).
-    if ((*tree.traps)[scene_.spheres[hitSphere].material])
+    if ((*tree.traps)[scene_.spheres[hit.sphere].material])
         for (int c = 0; c < 3; ++c)
-            if (reflectedGain[c] + transmittedGain[c] > 1.0 && r.weight[c] > 0.0) tree.amplified = true;
-    dvec3 reflectedWeight = childWeight(r.weight, reflectedGain);
-    std::optional<PendingRay> refractedRay;
-    if (settings.refraction && m.refracts()) {
-        const dvec3 transmittedWeight = childWeight(r.weight, transmittedGain);
-        MediumStack media = r.media;
-        const double eta = crossSurface(scene_, fromOutside, m, hitSphere, media);
-        dvec3 refracted;
-        if (!refractDirection(d, n, eta, refracted)) {
-            // Total internal reflection is the reflected ray in the same
-            // medium: one ray carrying both weights (exactly SPEC §4.5).
-            reflectedWeight = glm::min(reflectedWeight + transmittedWeight, dvec3(kMaxWeight));
-        } else {
-            PendingRay child{{x, refracted}, transmittedWeight, r.depth + 1, hitSphere, fromOutside, true, media};
-            if (worthTracing(transmittedWeight)) refractedRay = std::move(child);
-            else defer(std::move(child));
-        }
+            if (gain[c] > 1.0 && r.weight[c] > 0.0) tree.amplified = true;
+    Children c = children(r, hit, settings);
+    std::optional<PendingRay> refractedRay, reflectedRay;
+    if (c.refracted) {
+        if (worthTracing(c.refracted->weight, cutOff)) refractedRay = std::move(c.refracted);
+        else tree.defer(std::move(*c.refracted), settings);
     }
-    std::optional<PendingRay> reflectedRay;
-    PendingRay reflectedChild{{x, reflectDirection(d, n)}, reflectedWeight, r.depth + 1, hitSphere, !fromOutside,
-                              false, r.media};
-    if (worthTracing(reflectedWeight)) reflectedRay = std::move(reflectedChild);
-    else defer(std::move(reflectedChild));
+    if (worthTracing(c.reflected.weight, cutOff)) reflectedRay = std::move(c.reflected);
+    else tree.defer(std::move(c.reflected), settings);
     // The lighter child is traced next and the heavier waits (as the
     // shader does, whose stack this bounds: ComputeRenderer.cpp); in an
     // amplifying scene the heavier goes first, so that a tree budget is
@@ -339,57 +422,28 @@ void CpuRenderer::spawnChildren(const PendingRay& r, const Material& m, std::uin
     if (refractedRay) stack.push_back(std::move(*refractedRay));
 }
 
-void CpuRenderer::trace(const PendingRay& root, dvec3& pixelSum, double saturation, double cutOff,
-                        const TraceSettings& settings, RayCounts& counts, TreeTrace& tree) const {
+// The ray tree (SPEC §4) below `root` (a camera ray, or a ray an earlier
+// cut-off left), depth first with an explicit stack, each ray's local term
+// added straight into pixelSum: the path of one ray, step for step the
+// shader's main (shaders/trace.comp).
+void CpuRenderer::traceTree(const PendingRay& root, dvec3& pixelSum, double saturation, double cutOff,
+                            const TraceSettings& settings, RayCounts& counts, TreeTrace& tree) const {
     std::vector<PendingRay> stack;
     stack.push_back(root);
-    auto worthTracing = [&](const dvec3& w) {
-        const double m = maxComponent(w);
-        return m > 0.0 && m >= cutOff;
-    };
-    auto defer = [&](PendingRay&& r) { tree.defer(std::move(r), settings); };
     while (!stack.empty()) {
         PendingRay r = std::move(stack.back());
         stack.pop_back();
-        for (int k = 0; k < 3; ++k)
-            if (pixelSum[k] >= saturation) r.weight[k] = 0.0;
-        if (!worthTracing(r.weight)) {
-            defer(std::move(r));
-            continue;
-        }
-        if (tree.budget != 0 && tree.rays >= tree.budget) {
-            tree.overBudget = true;
-            tree.lost += r.weight;
-            continue;
-        }
-        ++tree.rays;
-        tree.deepest = std::max(tree.deepest, r.depth);
-        if (r.depth > 0) ++(r.refracted ? counts.refracted : counts.reflected);
-
-        // 1. Closest hit.
+        if (!admitRay(r, pixelSum, saturation, cutOff, settings, counts, tree)) continue;
+        // 1–2. The closest hit; the background on a miss.
         Hit hit;
-        const StartsOn start = r.inward ? StartsOn::Entering : StartsOn::Leaving;
-        if (!closestHit(r.ray, r.fromSphere, start, hit)) {
+        if (!findHit(r, hit)) {
             addWeighted(pixelSum, r.weight, scene_.background);
             continue;
         }
-        const Sphere& sphere = scene_.spheres[hit.sphere];
-        const Material& m = scene_.materials[sphere.material];
-
-        // 2. Hit point, outward normal No, shading normal N.
-        // The hit point is o + t d, not re-projected (see trace.comp).
-        const dvec3 x = r.ray.origin + hit.t * r.ray.direction;
-        const dvec3 outward = outwardNormal(sphere, r.ray, hit.t);
-        const dvec3 d = r.ray.direction;
-        const bool fromOutside = glm::dot(d, outward) < 0.0;
-        const dvec3 n = fromOutside ? outward : -outward;
-        const dvec3 v = -d;
-
-        // 3. Local Phong term with binary shadows.
-        addWeighted(pixelSum, r.weight, localTerm(m, hit.sphere, x, n, v, fromOutside, settings, counts));
-
-        // 4–5. Children: reflection, and refraction through the medium stack.
-        spawnChildren(r, m, hit.sphere, x, n, fromOutside, cutOff, settings, tree, stack);
+        // 3. The local Phong term with binary shadows.
+        addWeighted(pixelSum, r.weight, localTerm(hit, -r.ray.direction, settings, counts));
+        // 4–5. The children: reflection, and refraction through the medium stack.
+        followChildren(r, hit, cutOff, settings, tree, stack);
     }
 }
 
@@ -418,15 +472,9 @@ CpuRenderer::Pixel CpuRenderer::renderPixel(const RenderRequest& request, int x,
     tree.anyTrap = std::find(traps->begin(), traps->end(), true) != traps->end();
     const bool continues = settings.tolerance > 0.0;
     for (int k = first; k < first + count; ++k) {
-        // SPEC §3: sub-pixel (a, b) at x = i + (a + ½)/s, y = j + (b + ½)/s.
-        const int a = k % s, b = k / s;
-        const double px = x + (a + 0.5) / s;
-        const double py = y + (b + 0.5) / s;
-        PendingRay primary;
-        primary.ray = {request.camera.eye, request.camera.direction(px, py)};
         ++counts.primary;
-        trace(primary, sum, saturation, continues ? std::max(settings.minWeight, kFirstRung) : settings.minWeight,
-              settings, counts, tree);
+        traceTree(cameraRay(request.camera, s, x, y, k), sum, saturation,
+                  continues ? std::max(settings.minWeight, kFirstRung) : settings.minWeight, settings, counts, tree);
     }
     for (;;) {
         estimate.add(radiance_, sum, tree.lost + tree.deferred, samples);
@@ -463,7 +511,7 @@ CpuRenderer::Pixel CpuRenderer::renderPixel(const RenderRequest& request, int x,
         tree.frontier.clear();
         tree.deferred = dvec3(0.0);
         tree.heaviestDeferred = 0.0;
-        for (const PendingRay& r : waiting) trace(r, sum, saturation, cutOff, settings, counts, tree);
+        for (const PendingRay& r : waiting) traceTree(r, sum, saturation, cutOff, settings, counts, tree);
     }
     return pixel;
 }

@@ -1,7 +1,9 @@
 // The CPU reference renderer: SPEC §3–§6 in double precision, on all cores.
 // It is the project's oracle (the "exact image" every error is measured
-// against) and the `--cpu` back end. Its trace() is the twin of the compute
-// shader's trace() in shaders/trace.comp: same ray tree, same order.
+// against) and the `--cpu` back end. Its traceTree() is the twin of the
+// compute shader's main (shaders/trace.comp): the same steps, by the same
+// names (cameraRay, admitRay, findHit, localTerm, followChildren, children),
+// in the same order; docs/design.md maps each to its shader function.
 #pragma once
 
 #include <memory>
@@ -38,16 +40,23 @@ public:
 private:
     struct Hit;
     struct PendingRay;
+    struct Children;
     struct TreeTrace;
-    void trace(const PendingRay& root, glm::dvec3& pixelSum, double saturation, double cutOff,
-               const TraceSettings& settings, RayCounts& counts, TreeTrace& tree) const;
-    void spawnChildren(const PendingRay& r, const Material& m, std::uint32_t hitSphere, const glm::dvec3& x,
-                       const glm::dvec3& n, bool fromOutside, double cutOff, const TraceSettings& settings,
-                       TreeTrace& tree, std::vector<PendingRay>& stack) const;
+    static PendingRay cameraRay(const Camera& camera, int s, int x, int y, int k);
+    void traceTree(const PendingRay& root, glm::dvec3& pixelSum, double saturation, double cutOff,
+                   const TraceSettings& settings, RayCounts& counts, TreeTrace& tree) const;
+    bool admitRay(PendingRay& r, const glm::dvec3& pixelSum, double saturation, double cutOff,
+                  const TraceSettings& settings, RayCounts& counts, TreeTrace& tree) const;
+    bool findHit(const PendingRay& r, Hit& hit) const;
     glm::dvec3 outwardNormal(const Sphere& sphere, const Ray& ray, double t) const;
-    glm::dvec3 localTerm(const Material& m, std::uint32_t hitSphere, const glm::dvec3& x, const glm::dvec3& n,
-                         const glm::dvec3& v, bool fromOutside, const TraceSettings& settings,
+    glm::dvec3 localTerm(const Hit& hit, const glm::dvec3& v, const TraceSettings& settings,
                          RayCounts& counts) const;
+    glm::dvec3 ambientTerm(const Hit& hit) const;
+    glm::dvec3 shadeLight(const Light& light, const Hit& hit, const glm::dvec3& v, const TraceSettings& settings,
+                          bool& castShadowRay) const;
+    void followChildren(const PendingRay& r, const Hit& hit, double cutOff, const TraceSettings& settings,
+                        TreeTrace& tree, std::vector<PendingRay>& stack) const;
+    Children children(const PendingRay& r, const Hit& hit, const TraceSettings& settings) const;
     bool closestHit(const Ray& ray, std::uint32_t fromSphere, StartsOn start, Hit& hit) const;
     bool occluded(const Ray& ray, double distance, std::uint32_t fromSphere, StartsOn start) const;
     double intersect(std::uint32_t sphere, const Ray& ray, std::uint32_t fromSphere, StartsOn start) const;

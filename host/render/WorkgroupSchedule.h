@@ -1,8 +1,8 @@
 // How the workgroups of a tile run, for the compute renderer: which share of
 // the tile each takes, and how long a tile in progress has left. The
-// compute renderer deals each workgroup its own pixels (trace.comp,
-// takePixel), and a device runs a few workgroups at once, each to its end:
-// lavapipe one a thread, in order. So the tile ends when its last workgroup
+// compute renderer deals each workgroup its own pixels
+// (shaders/schedule/pixels.glsl, takePixel), and a device runs a few
+// workgroups at once, each to its end: lavapipe one a thread, in order. So the tile ends when its last workgroup
 // does, and near its end fewer workgroups than executors are left and the
 // tile slows: a tail that neither the pixels finished nor the cost done
 // foresees, and the forecast below does.
@@ -31,7 +31,7 @@ double scheduleSecondsLeft(const std::vector<WorkgroupWork>& workgroups, std::si
 
 // lavapipe gives each thread a contiguous range of workgroup IDs, so the
 // shares of the tile that neighbouring workgroups take should lie apart:
-// workgroup g takes share g · stride mod count (trace.comp, takePixel). The
+// workgroup g takes share g · stride mod count (schedule/pixels.glsl, takePixel). The
 // stride nearest count / golden ratio that is coprime with count makes that
 // a permutation in which any range of workgroups takes shares spread over
 // the whole tile.

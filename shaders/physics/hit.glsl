@@ -1,0 +1,170 @@
+// SPEC §4.1 and §4.3: the closest surface a ray meets (findHit, closestHit)
+// and whether any surface blocks a segment (occluded), by brute force over
+// the spheres, snell's BVH walk (bvh_walk.glsl) or the device's ray queries.
+// The intersection maths is intersect.glsl's (explained in
+// host/reference/Intersect.h); here a sphere is fetched and the ray's
+// relation to it decided. Pure but for one hook: each pass of a search loop
+// is reported to the scheduler, which counts it towards lavapipe's loop limit
+// and, when measuring, its lanes (schedule/counters.glsl).
+#ifndef SNELL_PHYSICS_HIT_GLSL
+#define SNELL_PHYSICS_HIT_GLSL
+
+void sphereLoopPass();  // a pass over the spheres
+void walkLoopPass();    // a pass of a BVH walk or of a ray query
+
+real intersectSphere(uint index, rvec3 origin, real originLength, rvec3 dir, uint fromSphere, uint start) {
+    uint mode = index == fromSphere ? start : ELSEWHERE;
+    rvec4 anchor = SPHERE_COUNT > 0u ? preloadedAnchor[index] : sphereAnchor(index);
+    rvec4 normal = SPHERE_COUNT > 0u ? preloadedNormal[index] : sphereNormal(index);
+    bool ellipsoid = SPHERE_COUNT > 0u ? ((ELLIPSOID_MASK >> index) & 1u) != 0u : anchor.w < 0.0;
+    if (HAS_ELLIPSOIDS && ellipsoid) {
+        rmat4 objectFromWorld = SPHERE_COUNT > 0u ? preloadedEllipsoid[index] : ellipsoidMatrix(uint(-anchor.w) - 1u);
+        return intersectEllipsoid(objectFromWorld, normal.w, origin, originLength, dir, mode);
+    }
+    return intersectTrueSphere(anchor, normal, origin, originLength, dir, mode);
+}
+
+// Word i of the BVH's nodes, through whichever the driver reads faster: the
+// texel view or the buffer's device address (shared_layout.h).
+uvec4 bvhWord(int i) {
+    if (BVH_WORDS) return fromHalves(BvhWords(uvec2(frame.bvhAddressLow, frame.bvhAddressHigh)).words[i]);
+    return texelFetch(bvhTexels, i);
+}
+
+#include "bvh_walk.glsl"
+
+uint traverseBvh(rvec3 origin, real originLength, rvec3 dir, uint fromSphere, uint start, bool anyHit,
+                 inout real tHit) {
+    rvec3 inverseDir = safeInverse(dir);
+    uint hit = NONE;
+    uint entry = 0u;
+    uint depth = 0u;
+    bool walking = true;
+    while (walking) {
+        walkLoopPass();
+        walkPass(entry, depth, walking, tHit, hit, origin, originLength, dir, inverseDir, fromSphere, start, anyHit);
+    }
+    return hit;
+}
+
+#ifdef SNELL_RAY_QUERY
+// The same search through the driver's traversal (VK_KHR_ray_query; on a GPU
+// with ray-tracing hardware, that hardware): it reports each sphere whose box
+// (rounded outwards, so it holds the sphere) the ray enters within tHit, and
+// the exact test of intersect.glsl, with its no-epsilon rules, decides as in
+// the walk above. A hit nearer than tHit is handed back to the query, which
+// then culls the boxes beyond it.
+uint queryBoxes(rvec3 origin, real originLength, rvec3 dir, uint fromSphere, uint start, bool anyHit,
+                inout real tHit) {
+    rayQueryEXT query;
+    rayQueryInitializeEXT(query, sphereBoxes, gl_RayFlagsNoneEXT, 0xffu, origin, 0.0, dir, tHit);
+    uint hit = NONE;
+    while (rayQueryProceedEXT(query)) {
+        walkLoopPass();
+        uint i = uint(rayQueryGetIntersectionPrimitiveIndexEXT(query, false));
+        real t = intersectSphere(i, origin, originLength, dir, fromSphere, start);
+        if (t < tHit) {
+            tHit = t;
+            hit = i;
+            rayQueryGenerateIntersectionEXT(query, t);
+            if (anyHit) rayQueryTerminateEXT(query);
+        }
+    }
+    return hit;
+}
+#endif
+
+// The BVH search of this build: the driver's traversal, else snell's walk.
+uint searchBvh(rvec3 origin, real originLength, rvec3 dir, uint fromSphere, uint start, bool anyHit,
+               inout real tHit) {
+#ifdef SNELL_RAY_QUERY
+    return queryBoxes(origin, originLength, dir, fromSphere, start, anyHit, tHit);
+#else
+    return traverseBvh(origin, originLength, dir, fromSphere, start, anyHit, tHit);
+#endif
+}
+
+// SPEC §4.1: the closest hit with t > 0; returns the sphere index or NONE.
+uint closestHit(rvec3 origin, rvec3 dir, uint fromSphere, uint start, out real tHit) {
+    tHit = NO_HIT;
+    real originLength = length(origin);
+    if (USE_BVH) return searchBvh(origin, originLength, dir, fromSphere, start, false, tHit);
+    uint hit = NONE;
+    if (SPHERE_COUNT > 0u) {
+        [[unroll]] for (uint i = 0u; i < SPHERE_COUNT; ++i) {
+            real t = intersectSphere(i, origin, originLength, dir, fromSphere, start);
+            if (t < tHit) { tHit = t; hit = i; }
+        }
+        return hit;
+    }
+    for (uint i = 0u; i < frame.sphereCount; ++i) {
+        sphereLoopPass();
+        real t = intersectSphere(i, origin, originLength, dir, fromSphere, start);
+        if (t < tHit) { tHit = t; hit = i; }
+    }
+    return hit;
+}
+
+// SPEC §4.3 visibility: does any surface cross the open segment (0, distance)?
+// Stops at the first occluder.
+// A ray that starts on a sphere headed into it (shading a hit from inside)
+// crosses that sphere at its chord unless the light is nearer: that one test
+// first spares the search its answer. (Not where the spheres are unrolled: a
+// dynamic index into them costs more than it spares.)
+bool crossesOwnSphere(rvec3 origin, real originLength, rvec3 dir, real distance, uint fromSphere, uint start) {
+    return (USE_BVH || SPHERE_COUNT == 0u) && start == ENTERING &&
+           intersectSphere(fromSphere, origin, originLength, dir, fromSphere, start) < distance;
+}
+
+bool occluded(rvec3 origin, rvec3 dir, real distance, uint fromSphere, uint start) {
+    real originLength = length(origin);
+    if (crossesOwnSphere(origin, originLength, dir, distance, fromSphere, start)) return true;
+    if (USE_BVH) return searchBvh(origin, originLength, dir, fromSphere, start, true, distance) != NONE;
+    bool blocked = false;
+    if (SPHERE_COUNT > 0u) {
+        [[unroll]] for (uint i = 0u; i < SPHERE_COUNT; ++i) {
+            if (!blocked) blocked = intersectSphere(i, origin, originLength, dir, fromSphere, start) < distance;
+        }
+        return blocked;
+    }
+    for (uint i = 0u; i < frame.sphereCount && !blocked; ++i) {
+        sphereLoopPass();
+        blocked = intersectSphere(i, origin, originLength, dir, fromSphere, start) < distance;
+    }
+    return blocked;
+}
+
+// 1–2. The closest hit of ray r (SPEC §4.1), and what shading needs there:
+// the material, the point, and the shading normal N. False on a miss. A ray
+// that resumes shading (resumeShading > 0) finds the same hit again.
+bool findHit(Ray r, out Hit h) {
+    real t;
+    h.sphere = closestHit(r.origin, r.dir, r.fromSphere, r.inward ? ENTERING : LEAVING, t);
+    if (h.sphere == NONE) return false;
+    uint material = sphereMaterial(h.sphere);
+    h.kd = materialKd(material);
+    h.ks = materialKs(material);
+    h.kt = HAS_REFRACTION ? materialKt(material) : vec4(0.0);
+    // The hit point o + t d, not re-projected onto the surface: re-projecting
+    // (centre + r n̂, or normalising the object-space point) rounds at the
+    // scale of the centre or of the largest semi-axis, which for a big floor
+    // sphere near the camera is 100× the error of o + t d. Self-intersection
+    // needs no point exactly on the surface (see intersectSphere).
+    rvec3 o = r.origin;
+    rvec3 d = r.dir;
+    h.point = o + t * d;
+    rvec4 anchor = sphereAnchor(h.sphere);
+    rvec3 outward;
+    if (HAS_ELLIPSOIDS && anchor.w < 0.0) {
+        rmat4 objectFromWorld = ellipsoidMatrix(uint(-anchor.w) - 1u);
+        rvec3 p = (objectFromWorld * rvec4(o, 1.0)).xyz + t * (rmat3(objectFromWorld) * d);
+        outward = normalize(transpose(rmat3(objectFromWorld)) * p);
+    } else {
+        outward = normalize(o - anchor.xyz + t * d + anchor.w * sphereNormal(h.sphere).xyz);
+    }
+    h.fromOutside = dot(d, outward) < 0.0;
+    h.normal = h.fromOutside ? outward : -outward;
+    return true;
+}
+
+#endif

@@ -1,0 +1,138 @@
+// A pixel's steps (render/Truncation.h; CpuRenderer::renderPixel is the
+// twin): its trees at a cut-off, what each step proves of its exact colour,
+// the next rung of the cut-off ladder, and the finished pixel written out.
+#ifndef SNELL_SCHEDULE_STEPS_GLSL
+#define SNELL_SCHEDULE_STEPS_GLSL
+
+// What the shader writes: the tile's pixels, row-major (a buffer: on lavapipe
+// an imageStore in a loop costs 13x a buffer store; rgb the colour, a the
+// pixel's truncation bound), and its own bookkeeping.
+layout(set = 0, binding = SNELL_BINDING_OUTPUT, std430) writeonly buffer OutputBlock { OutputPixel outputPixels[]; };
+
+SlotState freshPixel(uint pixelIndex) {
+    return SlotState(vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0), vec4(INFINITY), vec4(0.0), pixelIndex, 0u, 0u, 0u,
+                     0u, 0u, 0u, 0u, 0u, 0u, 0u, 0u, firstCutOff, 0.0, INFINITY, INFINITY, 0.0, 0u, 0u, 0u);
+}
+
+// What a step of a pixel proves of its exact colour: its colour is a lower
+// bound and its colour plus the weight it has not traced times the radiance
+// bound an upper bound; the pixel keeps the best of each (render/Truncation.h,
+// PixelEstimate, its twin). Returns the bound on the clamped colour.
+float addStep(inout SlotState state, float samples, out bool unbounded) {
+    vec3 value = state.sum.rgb / samples;
+    vec3 notTraced = state.lost.rgb + state.deferred.rgb;
+    state.lower.rgb = max(state.lower.rgb, value);
+    state.upper.rgb = min(state.upper.rgb, value + weighted(notTraced, frame.radiance.rgb) / samples);
+    vec3 gap = min(state.upper.rgb, vec3(1.0)) - min(state.lower.rgb, vec3(1.0));
+    unbounded = any(bvec3(uvec3(greaterThan(state.upper.rgb, vec3(3.0e38))) & uvec3(lessThan(state.lower.rgb, vec3(1.0)))));
+    return max(0.0, max(gap.r, max(gap.g, gap.b)));
+}
+
+// The estimated error of a pixel that cannot be certified, from how far its
+// last steps moved its colour and how the light its untraced weight may carry
+// changed: a geometric tail (render/Truncation.h, ErrorEstimate, its twin).
+// +inf while unknown or not shrinking.
+float estimateError(inout SlotState state, float samples) {
+    vec3 colour = min(state.lower.rgb, vec3(1.0));
+    vec3 open = mix(weighted(state.deferred.rgb, frame.localRadiance.rgb) / samples, vec3(0.0),
+                    greaterThanEqual(colour, vec3(1.0)));
+    float weight = max(open.r, max(open.g, open.b));
+    if (state.steps > 0u) {
+        vec3 moved = abs(colour - state.settled.rgb);
+        state.moveBefore = state.lastMove;
+        state.lastMove = max(moved.r, max(moved.g, moved.b));
+    }
+    float previousWeight = state.steps > 0u ? state.settledWeight : INFINITY;
+    state.settled = vec4(colour, 0.0);
+    state.settledWeight = weight;
+    state.steps++;
+    if (state.steps < 3u || !(weight < previousWeight)) return INFINITY;
+    float change = state.lastMove;
+    float rho = max(change / state.moveBefore, weight / previousWeight);
+    if (!(rho < 1.0) && change > 0.0) return INFINITY;
+    return max(weight, change > 0.0 ? change / (1.0 - rho) : 0.0);
+}
+
+// The rung of the cut-off ladder at or below w > 0: w with its mantissa
+// cleared, a power of two (render/RenderRequest.h, cutOffRung).
+float cutOffRung(float w) { return uintBitsToFloat(floatBitsToUint(w) & 0x7f800000u); }
+
+// What a finished step proves of its pixel (addStep, estimateError).
+struct StepOutcome {
+    float bound;     // on the clamped colour's truncation error
+    bool unbounded;  // no finite bound: light of a gain >= 1 was left
+    float estimate;  // the estimated error where unbounded
+    bool certified;  // bound within the tolerance
+    bool settled;    // stopped on its estimate instead
+};
+
+StepOutcome assessStep(inout SlotState state) {
+    StepOutcome o;
+    // (SPEC §3 mean, clamped on output.)
+    o.bound = addStep(state, float(samples), o.unbounded);
+    o.estimate = estimateError(state, float(samples));
+    o.certified = o.bound <= tolerance;
+    o.settled = frame.estimate != 0u && o.unbounded && o.estimate <= tolerance &&
+                (state.amplified == 0u || o.estimate <= frame.amplifiedEstimate);
+    return o;
+}
+
+// The cut-off of the pixel's next step, or 0 where it is finished. The next
+// rung: four below the heaviest ray this step left (render/RenderRequest.h,
+// nextRung), not under the floor; but a pixel whose trees gained weight goes
+// on below it, until its diverging channels saturate or its trees reach the
+// budget (SPEC §4 amplifying materials; as CpuRenderer::renderPixel does).
+float nextCutOff(SlotState state, StepOutcome o) {
+    float heaviest = state.heaviestLeft;
+    if (!(tolerance > 0.0) || o.certified || o.settled || !(heaviest > 0.0) || state.overBudget != 0u) return 0.0;
+    bool belowFloor = TRAPS && o.unbounded && state.amplified != 0u && pixelBudget != 0u;
+    float next = cutOffRung(heaviest) / 16.0;
+    if (!belowFloor) next = max(floorCutOff, next);
+    return next <= heaviest ? next : 0.0;
+}
+
+// The next step traces on from the rays this one left in the frontier.
+void beginStep(inout SlotState state) {
+    state.deferred.rgb = vec3(0.0);
+    state.heaviestLeft = 0.0;
+    state.frontierOld = state.frontierCount;
+}
+
+// The finished pixel written out (render/Truncation.h: its colour, bound and
+// how it stopped), and the invocation moved on to its next pixel.
+void finishPixel(uint slot, inout SlotState state, StepOutcome o, uint shadowRays) {
+    // A pixel that dropped light that may grow, and has not saturated, has
+    // neither a bound nor an estimate: it is over the tolerance, and says why.
+    bool dropped = state.droppedGrowing != 0u && o.unbounded;
+    bool overTolerance = tolerance > 0.0 && !o.certified && (!o.settled || dropped);
+    outputPixels[state.pixel] = OutputPixel(
+        vec4(state.lower.rgb, o.unbounded ? -o.bound : o.bound),
+        vec4(o.settled && !dropped ? o.estimate : -1.0, float(state.overBudget),
+             dropped ? 2.0 : overTolerance ? 1.0 : 0.0, float(state.treeRays)));
+    uint finished = state.finished + 1u;
+    uint rays = state.rays;
+    state = freshPixel(takePixel());
+    state.finished = finished;
+    state.rays = rays;
+    slotStates[slot].finished = finished;
+    slotStates[slot].rays = rays + shadowRays;
+}
+
+// The pixel's step has no ray left: on at a lower cut-off (cutOff), or the
+// pixel is finished and the invocation moves to its next one (pixel, within
+// the tile). Returns whether the invocation is done with the tile.
+bool endStep(uint slot, inout SlotState state, inout uvec2 pixel, inout float cutOff, uint shadowRays) {
+    StepOutcome outcome = assessStep(state);
+    float next = nextCutOff(state, outcome);
+    if (next > 0.0) {
+        cutOff = next;
+        beginStep(state);
+        return false;
+    }
+    finishPixel(slot, state, outcome, shadowRays);
+    pixel = uvec2(state.pixel % tile.width, state.pixel / tile.width);
+    cutOff = firstCutOff;
+    return state.pixel >= tilePixels;
+}
+
+#endif
