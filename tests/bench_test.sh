@@ -7,23 +7,38 @@
 # the floor, the walk's floor on the BVH scenes (casting the renderer's
 # rays), the peers and the scaling curve are there; bench/summarize.py
 # makes its tables and plot from them. Not a timed test.
-# BENCH_PART runs one part, so the parts run side by side: "scenes" (scenes/,
-# the walk's floor of scenes/grid), "bench" (the bench scenes, their peers,
-# the walk's floor of bench/grid), "scaling" (one scene and the scaling
-# curve; then --no-scaling); by default all of them in one run.
+# BENCH_PART runs one part, so the parts run side by side: "scenes:K/N" or
+# "bench:K/N" (the K-th of N shares of scenes/ or of the bench scenes, dealt
+# round and linked into a folder of the same name, which the bench groups as
+# it groups the folder: the bench scenes with their peers), or "scaling" (one
+# scene and the scaling curve; then --no-scaling); by default all of it.
 set -u
 : "${SNELL:?}" "${SOURCE:?}" "${PYTHON:=python3}"
 part=${BENCH_PART:-all}
-shared="$SOURCE/../shared"
-case "$part" in
-  all) what=() ;;
-  scenes) what=(--no-scaling "$SOURCE/scenes") ;;
-  bench) what=(--no-scaling "$shared/bench-scenes") ;;
-  scaling) what=("$SOURCE/scenes/basic.scn") ;;
-  *) echo "FAIL: BENCH_PART=$part is not all, scenes, bench or scaling"; exit 1 ;;
-esac
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
+what=()
+names=()  # the scenes of this part, as the bench names them
+case "$part" in
+  all) ;;
+  scaling) what=("$SOURCE/scenes/basic.scn") ;;
+  scenes:*/* | bench:*/*)
+    kind=${part%%:*} share=${part#*:}
+    k=${share%/*} n=${share#*/}
+    if [ "$kind" = scenes ]; then from="$SOURCE/scenes" folder=scenes; else from="$SOURCE/../shared/bench-scenes" folder=bench-scenes; fi
+    mkdir -p "$out/in/$folder"
+    i=0
+    for f in "$from"/*.scn; do
+      if [ $((i % n + 1)) -eq "$k" ]; then
+        ln -s "$f" "$out/in/$folder/" && names+=("$kind/$(basename "$f" .scn)")
+      fi
+      i=$((i + 1))
+    done
+    [ ${#names[@]} -gt 0 ] || { echo "FAIL: BENCH_PART=$part chooses no scene"; exit 1; }
+    what=(--no-scaling "$out/in/$folder") ;;
+  *) echo "FAIL: BENCH_PART=$part is not all, scenes:K/N, bench:K/N or scaling"; exit 1 ;;
+esac
+has() { [ "$part" = all ] || printf '%s\n' "${names[@]}" | grep -qx "$1"; }
 "$SNELL" bench --quick --source-dir "$SOURCE" -o "$out" "${what[@]}" 2>"$out/log"; status=$?
 cat "$out/log"
 [ $status -eq 0 ] || { echo "FAIL: bench exited with $status"; exit 1; }
@@ -31,18 +46,18 @@ for f in bench.csv bench.json; do [ -s "$out/$f" ] || { echo "FAIL: no $f"; exit
 "$PYTHON" "$SOURCE/bench/summarize.py" "$out/bench.json" --plot "$out/bench.png" >"$out/tables.md" ||
   { echo "FAIL: bench/summarize.py"; exit 1; }
 [ "$(head -c 4 "$out/bench.png" | od -An -c | tr -d ' ')" = "211PNG" ] || { echo "FAIL: no plot"; exit 1; }
-if [ "$part" = all ] || [ "$part" = bench ]; then
+if has bench/simple; then
   grep -q "^| bench/simple" "$out/tables.md" || { echo "FAIL: no table row for bench/simple"; exit 1; }
 fi
 grep -q "^| scene | default ms | price of the default" "$out/tables.md" || { echo "FAIL: no price table"; exit 1; }
-if [ "$part" != scaling ]; then
+if has scenes/grid || has bench/grid; then
   grep -q "^| BVH scene (depth 0) | size | walk's floor ms" "$out/tables.md" || { echo "FAIL: no walk floor table"; exit 1; }
 fi
 grep -q "^Price of the default: geometric mean" "$out/tables.md" || { echo "FAIL: no price summary"; exit 1; }
 grep -q "^price of the default: geometric mean" "$out/log" || { echo "FAIL: no price summary in the log"; exit 1; }
-"$PYTHON" - "$out" "$part" <<'PY'
+"$PYTHON" - "$out" "$part" "${names[@]}" <<'PY'
 import csv, json, sys, os
-out, part = sys.argv[1], sys.argv[2]
+out, part, names = sys.argv[1], sys.argv[2], set(sys.argv[3:])
 d = json.load(open(os.path.join(out, "bench.json")))
 fail = []
 if not d["ceiling_tests_per_s"]["centre_radius"] > 0: fail.append("no ceiling")
@@ -61,16 +76,19 @@ for r in d["results"]:
         fail.append(f"{name}: default error {r['error']['mean_abs_error']} > 0.5/255")
     if not r["cpu_default_ms"] > 0: fail.append(f"{name}: no CPU time at the same settings")
 scenes = {r["scene"] for r in d["results"]}
-if part in ("all", "scenes") and not any(s.startswith("scenes/") for s in scenes): fail.append("no scenes/ scenes")
-if part in ("all", "bench") and not any(s.startswith("bench/") for s in scenes): fail.append("no bench scenes")
-if part in ("all", "bench") and not d["peers"]: fail.append("no peers (../shared/bench-scenes)")
+if part == "all":
+    if not any(s.startswith("scenes/") for s in scenes): fail.append("no scenes/ scenes")
+    if not any(s.startswith("bench/") for s in scenes): fail.append("no bench scenes")
+elif names and scenes != names: fail.append(f"scenes {sorted(scenes)}, the part's {sorted(names)}")
+if (part == "all" or any(n.startswith("bench/") for n in names)) and not d["peers"]:
+    fail.append("no peers (../shared/bench-scenes)")
 for p in d["peers"]:
     if not (p["snell_dispatch_ms"] > 0 and p["snell_command_ms"] > 0 and p["cpu_reference_ms"] > 0):
         fail.append(f"peer {p}")
 # The walk's floor on each BVH scene: the renderer's walk alone, casting the
 # renderer's rays (the same camera and shadow rays, as counted).
 floors = {w["scene"] for w in d.get("walk_floors", [])}
-for need in {"all": ("scenes/grid", "bench/grid"), "scenes": ("scenes/grid",), "bench": ("bench/grid",)}.get(part, ()):
+for need in ("scenes/grid", "bench/grid") if part == "all" else [n for n in names if n.endswith("/grid")]:
     if need not in floors: fail.append(f"no walk floor for {need}")
 for w in d.get("walk_floors", []):
     if not (w["floor_kernel_ms"] > 0 and w["render_depth0_ms"] > 0): fail.append(f"walk floor {w}")
@@ -83,7 +101,7 @@ for w in d.get("walk_floors", []):
         fail.append(f"walk floor {w['scene']}: {w['floor_kernel_rays']} rays, the renderer {w['render_depth0_rays']}")
 if part in ("all", "scaling") and [s["spheres"] for s in d["scaling"]] != [10, 100, 1000, 10000]:
     fail.append("scaling counts")
-if part in ("scenes", "bench") and d["scaling"]: fail.append("a scaling curve under --no-scaling")
+if part not in ("all", "scaling") and d["scaling"]: fail.append("a scaling curve under --no-scaling")
 for s in d["scaling"]:
     if not s["render_ms"]["median"] > 0: fail.append(f"scaling {s}")
 # The price of the default, per scene: its time over the fastest fixed tree's
