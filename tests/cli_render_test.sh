@@ -159,6 +159,7 @@ printf 'view 8 1\nsphere\nmove 1 x 2\n' | "$SNELL" render - -o "$work/x.png" 2>"
 "$SNELL" compare "$work/other.png" "$work/file.png" --max-mean 255 --max-bad 100 >/dev/null && ok || bad "compare --max-mean/--max-bad"
 "$SNELL" compare "$work/nothing.png" "$work/file.png" 2>"$work/err"; status=$?
 [ $status -eq 2 ] && grep -q "snell: error: " "$work/err" && ok || bad "compare of a missing image: status $status"
+"$SNELL" render "$SCENES/basic.scn" --size 32 -q -o "$work/basic.png" || bad "render basic.scn at 32²"
 "$SNELL" compare "$work/basic.png" "$work/file.png" 2>"$work/err"; status=$?
 [ $status -eq 2 ] && grep -q "size" "$work/err" && ok || bad "compare of images of different sizes: status $status"
 "$SNELL" render "$SCENES/glass.scn" --size 32 -q --cpu --tolerance 0 --depth 3 -o "$work/ref.pfm" --bound-image "$work/bound.pfm" &&
