@@ -435,7 +435,8 @@ RenderRequest SceneRun::requestFor(const Setting& setting) const {
 ComputeRenderer& SceneRun::rendererFor(const Setting& setting) {
     auto& renderer = renderers[{int(setting.precision), int(setting.bvh)}];
     if (!renderer)
-        renderer = std::make_unique<ComputeRenderer>(context, scene, base.camera, setting.precision, setting.bvh);
+        renderer = std::make_unique<ComputeRenderer>(
+            context, scene, base.camera, RendererOptions{.precision = setting.precision, .bvh = setting.bvh});
     return *renderer;
 }
 
@@ -445,7 +446,7 @@ std::pair<Stats, Stats> SceneRun::measureSideBySide(const Setting& a, const Sett
     // A renderer each: one keeps one pipeline and its buffers, and a render
     // with another specialisation would re-create them.
     ComputeRenderer& rendererA = rendererFor(a);
-    ComputeRenderer rendererB(context, scene, base.camera, b.precision, b.bvh);
+    ComputeRenderer rendererB(context, scene, base.camera, RendererOptions{.precision = b.precision, .bvh = b.bvh});
     std::vector<double> msA, msB;
     auto block = [&](ComputeRenderer& renderer, const RenderRequest& request, std::vector<double>& ms) {
         renderer.render(request, false);

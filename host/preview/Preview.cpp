@@ -178,8 +178,10 @@ void Session::loadScene(std::unique_ptr<Scene> scene) {
     const bool keepCamera = scene_ && !camera_.atHome();
     size_ = o_.size.value_or(scene->imageSize);
     const Camera home = Camera::fromSpec(size_, scene->halfWidth);
-    auto renderer = std::make_unique<ComputeRenderer>(*context_, *scene, home, o_.precision, gpu::BvhMode::Auto,
-                                                      o_.traversal);
+    RendererOptions options;
+    options.precision = o_.precision;
+    options.traversal = o_.traversal;
+    auto renderer = std::make_unique<ComputeRenderer>(*context_, *scene, home, options);
     renderer_ = std::move(renderer);  // the old renderer goes before its scene
     scene_ = std::move(scene);
     if (!keepCamera) camera_ = OrbitCamera(*scene_, home, scene_->halfWidth);
