@@ -72,7 +72,6 @@ public:
     // What the last render's kernel was, and the paths this scene takes here.
     bool kernelFolded() const;  // its specialisation folded in (RendererOptions::foldSpecialisation)
     bool kernelAddressedStacks() const;  // its stacks read through their addresses
-    bool readsBvhWords() const { return policy_.bvhWords; }
     bool stackInRegisters() const { return policy_.stackInRegisters; }
     bool sharesShadowRays() const { return policy_.sharesShadowRays; }
     // "pipeline", "shader object" (made from its SPIR-V, its binary kept), or
