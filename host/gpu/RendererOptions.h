@@ -1,6 +1,6 @@
 // How a ComputeRenderer traces: the precision and the sphere search, and the
 // switches tests and measurements use to pick each of the kernel's paths.
-// Unset choices are the device's (ComputeRenderer.h); every path traces the
+// Unset choices are the device's (gpu/KernelPolicy.h); every path traces the
 // same image.
 #pragma once
 

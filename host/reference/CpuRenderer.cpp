@@ -329,7 +329,7 @@ void CpuRenderer::spawnChildren(const PendingRay& r, const Material& m, std::uin
     if (worthTracing(reflectedWeight)) reflectedRay = std::move(reflectedChild);
     else defer(std::move(reflectedChild));
     // The lighter child is traced next and the heavier waits (as the
-    // shader does, whose stack this bounds: ComputeRenderer.cpp); in an
+    // shader does, whose stack this bounds: gpu/KernelPolicy.cpp); in an
     // amplifying scene the heavier goes first, so that a tree budget is
     // spent on the weightiest rays, those that saturate a diverging channel.
     if (reflectedRay && refractedRay &&
