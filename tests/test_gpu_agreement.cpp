@@ -51,7 +51,7 @@ struct Case {
     bool noSpeckles = true;
     snell::gpu::Precision precision = snell::gpu::Precision::Fp32;
     snell::gpu::Traversal traversal = snell::gpu::Traversal::Walk;
-    // Planned as on a GPU (ComputeRenderer::planAsGpu): its short frontiers
+    // Planned as on a GPU (RendererOptions::planAsGpu): its short frontiers
     // and thousands of workgroups sharing the tile, on lavapipe.
     bool gpuPlan = false;
 };
@@ -177,8 +177,8 @@ TEST_P(GpuAgreement, MatchesCpuReference) {
     if (c.traversal == snell::gpu::Traversal::RayQuery && !context().rayQueriesEnabled()) {
         // A driver without ray queries (Mesa 22.3's lavapipe) refuses them, saying why.
         try {
-            snell::ComputeRenderer refused(context(), scene, request.camera, c.precision, snell::gpu::BvhMode::Auto,
-                                           c.traversal);
+            snell::ComputeRenderer refused(context(), scene, request.camera,
+                                           {.precision = c.precision, .traversal = c.traversal});
             ADD_FAILURE() << "--traversal ray-query accepted on a device without ray queries";
         } catch (const snell::vk::VulkanError& e) {
             EXPECT_NE(std::string(e.what()).find("VK_KHR_"), std::string::npos) << e.what();
@@ -187,17 +187,16 @@ TEST_P(GpuAgreement, MatchesCpuReference) {
     }
     if (c.precision == snell::gpu::Precision::Fp64 && !context().fp64Refusal().empty()) {
         // A driver the fp64 shader renders wrong on refuses it, saying why.
-        EXPECT_THROW(snell::ComputeRenderer(context(), scene, request.camera, c.precision, snell::gpu::BvhMode::Auto,
-                                            c.traversal),
+        EXPECT_THROW(snell::ComputeRenderer(context(), scene, request.camera,
+                                            {.precision = c.precision, .traversal = c.traversal}),
                      snell::vk::VulkanError);
         return;
     }
-    snell::ComputeRenderer gpuRenderer(context(), scene, request.camera, c.precision, snell::gpu::BvhMode::Auto,
-                                       c.traversal);
+    snell::ComputeRenderer gpuRenderer(context(), scene, request.camera,
+                                       {.precision = c.precision, .traversal = c.traversal, .planAsGpu = c.gpuPlan});
     const bool bvh = scene.spheres.size() > snell::gpu::kBvhThreshold;
     EXPECT_STREQ(gpuRenderer.traversal(),
                  c.traversal == snell::gpu::Traversal::RayQuery ? "ray-query" : bvh ? "bvh" : "loop");
-    gpuRenderer.planAsGpu(c.gpuPlan);
     const snell::GpuRenderResult gpu = gpuRenderer.render(request, false);
     EXPECT_EQ(context().validationMessages(), messagesBefore) << "the Vulkan validation layer reported messages";
 
@@ -400,8 +399,8 @@ TEST(GpuResume, SuspendingNeverChangesTheImage) {
         const snell::RenderRequest request = wholeImage(scene, 40);
         snell::ComputeRenderer gpu(context(), scene, request.camera);
         const snell::GpuRenderResult whole = gpu.render(request, false);
-        gpu.forceLoopBudget(48);
-        const snell::GpuRenderResult resumed = gpu.render(request, false);
+        snell::ComputeRenderer budgeted(context(), scene, request.camera, {.loopBudget = 48});
+        const snell::GpuRenderResult resumed = budgeted.render(request, false);
         EXPECT_GT(resumed.dispatches, 2 * whole.dispatches) << "the budget forced too few suspensions to test";
         EXPECT_EQ(resumed.image.rgb, whole.image.rgb);
     }
@@ -553,8 +552,7 @@ TEST(GpuSpecialisation, FoldedKernelTracesTheSameImage) {
         SCOPED_TRACE(file);
         const snell::Scene scene = snell::parseSceneFile(file);
         const snell::RenderRequest request = wholeImage(scene, 96);
-        snell::ComputeRenderer driverSpecialised(context(), scene, request.camera);
-        driverSpecialised.foldSpecialisation(false);
+        snell::ComputeRenderer driverSpecialised(context(), scene, request.camera, {.foldSpecialisation = false});
         const snell::GpuRenderResult own = driverSpecialised.render(request, false);
         snell::ComputeRenderer folded(context(), scene, request.camera);
         const snell::GpuRenderResult image = folded.render(request, false);
@@ -596,12 +594,12 @@ TEST(GpuShaderObjects, KeptBinaryTracesThePipelinesImage) {
         if (c.precision == snell::gpu::Precision::Fp64 && !objects.float64Supported()) continue;
         const snell::Scene scene = snell::parseSceneFile(c.file);
         const snell::RenderRequest request = wholeImage(scene, 96);
-        snell::ComputeRenderer pipeline(objects, scene, request.camera, c.precision);
-        pipeline.useShaderObjects(false);
+        snell::ComputeRenderer pipeline(objects, scene, request.camera,
+                                        {.precision = c.precision, .useShaderObjects = false});
         const snell::GpuRenderResult own = pipeline.render(request, false);
         EXPECT_STREQ(pipeline.kernelObject(), "pipeline");
         for (const char* expected : {"shader object", "shader binary"}) {
-            snell::ComputeRenderer renderer(objects, scene, request.camera, c.precision);
+            snell::ComputeRenderer renderer(objects, scene, request.camera, {.precision = c.precision});
             const snell::GpuRenderResult image = renderer.render(request, false);
             EXPECT_STREQ(renderer.kernelObject(), support.enabled ? expected : "pipeline");
             ASSERT_EQ(image.image.rgb.size(), own.image.rgb.size());
@@ -620,24 +618,29 @@ struct WalkCase {
     snell::gpu::Precision precision;
 };
 
-// Renders each case with `choose(renderer, false)` and again with
-// `choose(renderer, true)` and requires the same image, bit for bit (and,
-// with countRays, the same rays of each kind).
+// Renders each case with `choose(options, false)` and again with
+// `choose(options, true)`, checking each renderer with `check`, and requires
+// the same image, bit for bit (and, with countRays, the same rays of each kind).
 void requireTheSameWalk(std::initializer_list<WalkCase> cases,
-                        const std::function<void(snell::ComputeRenderer&, bool)>& choose, const char* what,
-                        bool countRays = false) {
+                        const std::function<void(snell::RendererOptions&, bool)>& choose, const char* what,
+                        bool countRays = false,
+                        const std::function<void(const snell::ComputeRenderer&, bool)>& check = {}) {
     for (const WalkCase& c : cases) {
         const bool wide = c.precision == snell::gpu::Precision::Fp64;
         SCOPED_TRACE(std::string(c.file) + (wide ? " fp64" : " fp32"));
         if (wide && !context().float64Supported()) continue;
         const snell::Scene scene = snell::parseSceneFile(c.file);
         const snell::RenderRequest request = wholeImage(scene, 64);
-        snell::ComputeRenderer renderer(context(), scene, request.camera, c.precision, snell::gpu::BvhMode::On,
-                                        snell::gpu::Traversal::Walk);
-        choose(renderer, false);
-        const snell::GpuRenderResult without = renderer.render(request, countRays);
-        choose(renderer, true);
-        const snell::GpuRenderResult with = renderer.render(request, countRays);
+        snell::RendererOptions options{.precision = c.precision, .bvh = snell::gpu::BvhMode::On,
+                                       .traversal = snell::gpu::Traversal::Walk};
+        choose(options, false);
+        snell::ComputeRenderer rendererWithout(context(), scene, request.camera, options);
+        if (check) check(rendererWithout, false);
+        const snell::GpuRenderResult without = rendererWithout.render(request, countRays);
+        choose(options, true);
+        snell::ComputeRenderer rendererWith(context(), scene, request.camera, options);
+        if (check) check(rendererWith, true);
+        const snell::GpuRenderResult with = rendererWith.render(request, countRays);
         ASSERT_EQ(with.image.rgb.size(), without.image.rgb.size());
         EXPECT_EQ(pixelsThatDiffer(without.image, with.image), 0u) << "pixels that differ between " << what;
         if (countRays) {
@@ -655,7 +658,7 @@ TEST(GpuBvhWords, AddressReadsTraceTheTexelsImage) {
     requireTheSameWalk({{SNELL_SOURCE_DIR "/scenes/grid.scn", snell::gpu::Precision::Fp32},
                         {SNELL_SOURCE_DIR "/scenes/grid.scn", snell::gpu::Precision::Fp64},
                         {SNELL_SHARED_DIR "/course-scenes/becker-SphereFlake2.scn", snell::gpu::Precision::Fp32}},
-                       [](snell::ComputeRenderer& renderer, bool words) { renderer.readBvhWords(words); },
+                       [](snell::RendererOptions& options, bool words) { options.readBvhWords = words; },
                        "the BVH's two views");
 }
 
@@ -691,12 +694,13 @@ TEST(GpuStacks, AddressesTraceTheStorageBuffersImage) {
         }
         std::vector<snell::Image> images;
         for (const bool byAddress : {false, true}) {
-            snell::ComputeRenderer renderer(context(), scene, request.camera, c.precision);
-            renderer.addressStacks(byAddress);
+            snell::ComputeRenderer renderer(context(), scene, request.camera,
+                                            {.precision = c.precision, .addressStacks = byAddress});
             const snell::GpuRenderResult whole = renderer.render(request, false);
             EXPECT_EQ(renderer.kernelAddressedStacks(), byAddress);
-            renderer.forceLoopBudget(48);
-            const snell::GpuRenderResult resumed = renderer.render(request, false);
+            snell::ComputeRenderer budgeted(context(), scene, request.camera,
+                                            {.precision = c.precision, .loopBudget = 48, .addressStacks = byAddress});
+            const snell::GpuRenderResult resumed = budgeted.render(request, false);
             EXPECT_GT(resumed.dispatches, 2 * whole.dispatches) << "the budget forced too few suspensions to test";
             ASSERT_EQ(whole.image.rgb.size(), std::size_t(3 * 48 * 48));
             ASSERT_EQ(resumed.image.rgb.size(), whole.image.rgb.size());
@@ -715,11 +719,10 @@ TEST(GpuBvhStack, RegistersTraceTheArraysImage) {
                         {SNELL_SOURCE_DIR "/scenes/grid.scn", snell::gpu::Precision::Fp64},
                         {SNELL_SHARED_DIR "/course-scenes/becker-SphereFlake2.scn", snell::gpu::Precision::Fp32},
                         {SNELL_SHARED_DIR "/course-scenes/becker-SphereFlake4.scn", snell::gpu::Precision::Fp32}},
-                       [](snell::ComputeRenderer& renderer, bool registers) {
-                           renderer.keepStackInRegisters(registers);
+                       [](snell::RendererOptions& options, bool registers) { options.stackInRegisters = registers; },
+                       "the two stacks", false, [](const snell::ComputeRenderer& renderer, bool registers) {
                            EXPECT_EQ(renderer.stackInRegisters(), registers);
-                       },
-                       "the two stacks");
+                       });
 }
 
 // The shadow rays of a subgroup's hits are walked by all its lanes, or each
@@ -737,11 +740,10 @@ TEST(GpuShadowRays, SharedTraceTheOwnRaysImage) {
                         {SNELL_SOURCE_DIR "/scenes/grid.scn", snell::gpu::Precision::Fp64},
                         {SNELL_SOURCE_DIR "/scenes/hard/lights-over-glass-bvh.scn", snell::gpu::Precision::Fp32},
                         {SNELL_SHARED_DIR "/course-scenes/becker-SphereFlake2.scn", snell::gpu::Precision::Fp32}},
-                       [shares](snell::ComputeRenderer& renderer, bool share) {
-                           renderer.shareShadowRays(share);
+                       [](snell::RendererOptions& options, bool share) { options.shareShadowRays = share; },
+                       "shared and own shadow rays", true, [shares](const snell::ComputeRenderer& renderer, bool share) {
                            EXPECT_EQ(renderer.sharesShadowRays(), share && shares);
-                       },
-                       "shared and own shadow rays", true);
+                       });
 }
 
 TEST(GpuPlan, TracesTheImageOfLavapipesPlan) {
@@ -752,8 +754,8 @@ TEST(GpuPlan, TracesTheImageOfLavapipesPlan) {
         request.trace.tolerance = 0.0;
         snell::ComputeRenderer gpu(context(), scene, request.camera);
         const snell::GpuRenderResult own = gpu.render(request, false);
-        gpu.planAsGpu(true);
-        const snell::GpuRenderResult planned = gpu.render(request, false);
+        snell::ComputeRenderer asGpu(context(), scene, request.camera, {.planAsGpu = true});
+        const snell::GpuRenderResult planned = asGpu.render(request, false);
         if (context().isCpuDevice()) {
             EXPECT_LT(own.invocations, planned.invocations);
             // grid: more shares than 32 words of bits, so the words' bits span words too.
