@@ -24,7 +24,7 @@ bool choosesRayQueries(const vk::Context& context, RendererOptions& options) {
         if (options.bvh == BvhMode::Auto) options.bvh = BvhMode::On;
     }
     // Auto takes the device's traversal on GPUs only: on lavapipe snell's walk
-    // measured faster (docs/performance.md, "The device's ray traversal").
+    // measured faster (docs/performance-log.md, "The device's ray traversal").
     return options.precision == Precision::Fp32 && context.rayQueriesEnabled() &&
            (options.traversal == Traversal::RayQuery ||
             (options.traversal == Traversal::Auto && !context.isCpuDevice()));
@@ -36,14 +36,14 @@ KernelPolicy devicePolicy(vk::Context& context, const RendererOptions& options, 
     // each lane's offset into a storage buffer against its size; its loads
     // and stores through a device address are faster, in the BVH walk and on
     // the ray and media stacks. Mesa 22.3 inlines its fetches and goes lane by
-    // lane through an address (docs/performance.md, "The BVH as a storage
+    // lane through an address (docs/performance-log.md, "The BVH as a storage
     // buffer", "The walk's floor", "The ray stack through its address").
     const bool addressesFaster = context.isLlvmpipe() && context.mesaMajor() >= 25;
     policy.bvhWords = options.readBvhWords.value_or(addressesFaster);
     policy.stacksByAddress = options.addressStacks.value_or(addressesFaster);
     // A CPU device runs a SIMD row's stores at per-lane indices lane by lane;
     // a GPU keeps such a stack in its local memory (unmeasured there: left
-    // as it was). docs/performance.md, "The walk's stack in registers".
+    // as it was). docs/performance-log.md, "The walk's stack in registers".
     policy.stackInRegisters = options.stackInRegisters.value_or(context.isCpuDevice()) && layout.usesBvh() &&
                               layout.bvhStackSize() <= SNELL_REGISTER_STACK_LIMIT;
     const std::uint32_t driverBudget = limitsLoopIterations(context) ? SNELL_LOOP_BUDGET_LIMITED : 0u;
@@ -52,7 +52,7 @@ KernelPolicy devicePolicy(vk::Context& context, const RendererOptions& options, 
     // size) lights at a time: worth it for SIMD rows of up to 16 lanes. On a
     // CPU device only, where a subgroup's lanes run in lockstep: a GPU's would
     // also need to meet at a subgroup barrier before they read each other's
-    // hits, and it is unmeasured there (docs/performance.md, "Shadow rays
+    // hits, and it is unmeasured there (docs/performance-log.md, "Shadow rays
     // shared out"). Only with snell's own walk and more than one light (one
     // shadow ray a lane has no one to share with), and where the walk cannot
     // be suspended (the shadow rays of a batch are walked in one loop).
@@ -68,7 +68,7 @@ KernelPolicy devicePolicy(vk::Context& context, const RendererOptions& options, 
 
 namespace {
 
-// How many rays may wait on an invocation's stack (trace.comp, spawnChildren).
+// How many rays may wait on an invocation's stack (schedule/tree.glsl, followChildren).
 // A ray waits only where a hit both reflects and refracts, and then the
 // lighter child goes on: below k waiting rays the path's weight is at most
 // q^k, q the largest gain of a lighter child (min(max ks, max kt) over the
@@ -80,7 +80,7 @@ namespace {
 // shader drops the child that would wait and counts it (SNELL_COUNTER_OVERFLOW).
 constexpr std::uint32_t kMaxRayStack = 256;
 
-// Frontier entries an invocation keeps (trace.comp, deferRay). On a CPU device
+// Frontier entries an invocation keeps (schedule/frontier.glsl, deferRay). On a CPU device
 // there are few invocations (a few workgroups a core) and room for many; a GPU
 // needs its invocations more than long frontiers, except in a scene with
 // traps, whose pixels go on below the floor from what waits there: a ray
@@ -89,7 +89,7 @@ constexpr std::uint32_t kMaxRayStack = 256;
 // 207/255 where the reference saturates); at 512 its image agrees with the
 // reference, though 811 of its pixels still lose rays under the floor there.
 // The longer frontier makes the loss rarer; it does not end it: such a pixel
-// claims no estimate of its error (trace.comp, finishPixel).
+// claims no estimate of its error (schedule/steps.glsl, finishPixel).
 constexpr std::uint32_t kCpuFrontier = 512;
 constexpr std::uint32_t kGpuFrontier = 32;
 std::uint32_t rayStackEntries(const Scene& scene, const TraceSettings& trace, bool reflection) {
@@ -148,8 +148,8 @@ Specialisation specialise(const Scene& scene, const GpuScene& layout, const Kern
     values[SNELL_SPEC_RAY_STACK] =
         hasRefraction ? rayStackEntries(scene, request.trace, hasReflection) + 1 : 1;  // + the suspended ray
     // Where ray trees diverge (refraction, a BVH) a workgroup whose share of
-    // the tile is taken helps with the others' (trace.comp, takePixel); on
-    // cheap, even scenes that cost more than it won (docs/performance.md).
+    // the tile is taken helps with the others' (schedule/pixels.glsl, takePixel); on
+    // cheap, even scenes that cost more than it won (docs/performance-log.md, "Help with the other shares").
     values[SNELL_SPEC_HELPS] = hasRefraction || layout.usesBvh();
     // Under a tolerance, a frontier for the rays a step leaves under its
     // cut-off; where it is full, rays are traced down to the floor instead.

@@ -9,7 +9,7 @@ namespace snell::gpu {
 
 // The tile's expected cost in the order its pixels are taken: the tile is
 // dealt in shares of runs of a workgroup's size, run r to share r mod W, and
-// each workgroup takes its share's runs in order (trace.comp, takePixel), so
+// each workgroup takes its share's runs in order (schedule/pixels.glsl, takePixel), so
 // what a workgroup has finished is, but for the pixels in progress, the
 // start of its share.
 void expectTileCost(const RenderRequest& request, const TilePlan& plan, const TileParams& tile,

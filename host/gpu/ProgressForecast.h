@@ -22,7 +22,7 @@ struct RenderProgress {
     TruncationReport truncation;
     // With an expected cost (RenderRequest::expectedCost), of the tile in
     // progress: each share's expected cost before each of its runs of pixels,
-    // in the order a workgroup takes them (trace.comp, takePixel), and the
+    // in the order a workgroup takes them (schedule/pixels.glsl, takePixel), and the
     // tile's in all.
     std::vector<std::vector<double>> costBefore;
     std::vector<std::uint64_t> sharePixels;  // each share's pixels

@@ -45,7 +45,7 @@ struct RendererOptions {
     // on CPU devices.
     std::optional<bool> stackInRegisters;
     // Whether the shadow rays of a subgroup's hits may be shared out among its
-    // lanes (trace.comp, shadeLightsShared) where the device and scene allow
+    // lanes (schedule/lights.glsl, shadeLightsShared) where the device and scene allow
     // it, or each lane walks its own in the lights' loop.
     bool shareShadowRays = true;
     // With false, the kernel is a pipeline even where the device has shader

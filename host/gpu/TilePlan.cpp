@@ -15,7 +15,8 @@ namespace {
 // 1 GiB 126 336 and 735 ms; showcase took 42 ms with 2^18 invocations and
 // 212 with a million (every pixel of the tile its own), tir 78 and 344.
 // 2^18 fills an H200 (132 multiprocessors of 2048 threads). (Where it
-// lost: scenes/glass 20.7 → 38.2 ms with 13 000 → 210 000; docs/performance.md.)
+// lost: scenes/glass 20.7 → 38.2 ms with 13 000 → 210 000;
+// docs/performance-log.md, "On a real GPU: an NVIDIA H200".)
 constexpr VkDeviceSize kStackBudget = 64ull << 20;
 constexpr VkDeviceSize kGpuStackBudget = 1ull << 30;
 constexpr VkDeviceSize kGpuInvocations = 1ull << 18;
@@ -115,7 +116,7 @@ TilePlan planTiles(const vk::Context& context, const RenderRequest& request, con
         std::clamp<VkDeviceSize>(std::min(slots, plan.tilePixels()) / SNELL_WORKGROUP_SIZE, 1, 65535) *
         SNELL_WORKGROUP_SIZE;
     // lavapipe gives each thread a contiguous range of workgroups: the shares
-    // of neighbouring workgroups are spread over the tile (trace.comp, share).
+    // of neighbouring workgroups are spread over the tile (schedule/dispatch.glsl, share).
     if (cpu) plan.workgroupStride = spreadingStride(std::uint32_t(plan.workgroups()));
     plan.helps = values[SNELL_SPEC_HELPS] != 0;
     return plan;

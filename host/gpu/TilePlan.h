@@ -22,7 +22,7 @@ constexpr int kMaxInterleavedSide = 2 * kMaxTileSide;
 bool interleaves(const PixelWindow& area);
 
 // The image's column and row of the tile's column x and row y (TileParams;
-// trace.comp, imagePixel).
+// schedule/pixels.glsl, imagePixel).
 int imageColumn(const TileParams& tile, std::uint32_t x);
 int imageRow(const TileParams& tile, std::uint32_t y);
 
@@ -41,7 +41,7 @@ struct TilePlan {
     // The rows streamed at a time: a row of blocks, or the whole of interleaved tiles.
     int bandRows() const { return interleaved ? area.height() : tileHeight; }
     std::uint64_t workgroups() const { return invocations / SNELL_WORKGROUP_SIZE; }
-    // The share of the tile's pixels workgroup w takes (trace.comp, takePixel).
+    // The share of the tile's pixels workgroup w takes (schedule/pixels.glsl, takePixel).
     std::uint64_t shareOf(std::uint64_t w) const { return w * workgroupStride % workgroups(); }
     VkDeviceSize tilePixels() const { return VkDeviceSize(tileWidth) * tileHeight; }
     // Tile (tx, ty): where it is, and how an invocation steps through it.

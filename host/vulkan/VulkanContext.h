@@ -56,7 +56,8 @@ FaultInjection parseFaultInjection(const std::string& text);
 // Whether the device's own ray traversal (VK_KHR_ray_query over
 // VK_KHR_acceleration_structure, with buffer device addresses) is enabled
 // where the device has it: never, on GPUs only (the default: on lavapipe,
-// snell's BVH walk measured faster; docs/performance.md), or on any device.
+// snell's BVH walk measured faster; docs/performance.md, "Drivers and
+// devices"), or on any device.
 enum class RayQueries { Off, OnGpus, On };
 
 struct ContextOptions {
