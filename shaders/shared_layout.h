@@ -9,7 +9,7 @@
 // struct below a run of RGBA32 texels (its vec4 members in order): texel
 // fetches gather a SIMD row's values in one vectorised step on lavapipe, about
 // 3x cheaper than the bounds-checked per-lane loads of a storage buffer
-// (docs/performance.md), and they count elements (2^27 texels on lavapipe), so
+// (docs/performance-log.md, "What lavapipe charges for"), and they count elements (2^27 texels on lavapipe), so
 // the documented limit of 4 000 000 spheres fits where 128 MiB of storage
 // buffer does not. Every view is RGBA32UI: integers are read as they are,
 // floats by their bits (uintBitsToFloat), exact either way. The
@@ -18,7 +18,7 @@
 // a function for every texel fetch, which in the walk's seven fetches a node
 // costs more than loads; and it loads from an address without the per-lane
 // bounds checks of a storage buffer, nor its 128 MiB limit, each word as two
-// 64-bit halves (wide_words.glsl; docs/performance.md, "The BVH as a storage
+// 64-bit halves (wide_words.glsl; docs/performance-log.md, "The BVH as a storage
 // buffer", "The walk's floor", "Words loaded as 64-bit halves").
 #ifndef SNELL_SHARED_LAYOUT_H
 #define SNELL_SHARED_LAYOUT_H
@@ -143,7 +143,7 @@ using uint = std::uint32_t;
 // Mesa's llvmpipe before 24 (lavapipe in Debian 12's Mesa 22.3) ends every
 // loop of a shader once one SIMD row has run 65535 loop iterations in total in
 // a dispatch; newer llvmpipe has no such limit (the renderer probes the
-// driver: host/gpu/ComputeRenderer.cpp). Under the limit an invocation
+// driver: host/gpu/DriverProbe.cpp). Under the limit an invocation
 // suspends its work (SlotState, the ray stack) when its subgroup has spent
 // SNELL_LOOP_BUDGET iterations, and the next dispatch resumes it.
 #define SNELL_DRIVER_LOOP_LIMIT 65535u
@@ -328,7 +328,7 @@ struct FrameParams {
 // SIMD row's width and its rows one by one: runs that fine keep the tiles
 // fair samples of a finely structured image (runs of 64 columns left the
 // tiles of becker-SphereFlake2 at 1400² 16 against 29 s), and cost the
-// kernel no more than coarse ones (docs/performance.md).
+// kernel no more than coarse ones (docs/performance-log.md, "Interleaved tiles").
 #define SNELL_TILE_COLUMN_RUN 8
 #define SNELL_TILE_ROW_RUN 1
 

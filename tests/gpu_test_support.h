@@ -50,24 +50,28 @@ struct WalkCase {
     gpu::Precision precision;
 };
 
-// Renders each case with `choose(renderer, false)` and again with
-// `choose(renderer, true)` and requires the same image, bit for bit (and,
-// with countRays, the same rays of each kind).
+// Renders each case with `choose(options, false)` and again with
+// `choose(options, true)`, checking each renderer with `check`, and requires
+// the same image, bit for bit (and, with countRays, the same rays of each kind).
 inline void requireTheSameWalk(std::initializer_list<WalkCase> cases,
-                        const std::function<void(ComputeRenderer&, bool)>& choose, const char* what,
-                        bool countRays = false) {
+                               const std::function<void(RendererOptions&, bool)>& choose, const char* what,
+                               bool countRays = false,
+                               const std::function<void(const ComputeRenderer&, bool)>& check = {}) {
     for (const WalkCase& c : cases) {
         const bool wide = c.precision == gpu::Precision::Fp64;
         SCOPED_TRACE(std::string(c.file) + (wide ? " fp64" : " fp32"));
         if (wide && !context().float64Supported()) continue;
         const Scene scene = parseSceneFile(c.file);
         const RenderRequest request = wholeImage(scene, 64);
-        ComputeRenderer renderer(context(), scene, request.camera, c.precision, gpu::BvhMode::On,
-                                        gpu::Traversal::Walk);
-        choose(renderer, false);
-        const GpuRenderResult without = renderer.render(request, countRays);
-        choose(renderer, true);
-        const GpuRenderResult with = renderer.render(request, countRays);
+        RendererOptions options{.precision = c.precision, .bvh = gpu::BvhMode::On, .traversal = gpu::Traversal::Walk};
+        choose(options, false);
+        ComputeRenderer rendererWithout(context(), scene, request.camera, options);
+        if (check) check(rendererWithout, false);
+        const GpuRenderResult without = rendererWithout.render(request, countRays);
+        choose(options, true);
+        ComputeRenderer rendererWith(context(), scene, request.camera, options);
+        if (check) check(rendererWith, true);
+        const GpuRenderResult with = rendererWith.render(request, countRays);
         ASSERT_EQ(with.image.rgb.size(), without.image.rgb.size());
         EXPECT_EQ(pixelsThatDiffer(without.image, with.image), 0u) << "pixels that differ between " << what;
         if (countRays) {

@@ -58,7 +58,7 @@ struct Case {
     bool noSpeckles = true;
     snell::gpu::Precision precision = snell::gpu::Precision::Fp32;
     snell::gpu::Traversal traversal = snell::gpu::Traversal::Walk;
-    // Planned as on a GPU (ComputeRenderer::planAsGpu): its short frontiers
+    // Planned as on a GPU (RendererOptions::planAsGpu): its short frontiers
     // and thousands of workgroups sharing the tile, on lavapipe.
     bool gpuPlan = false;
 };
@@ -182,8 +182,8 @@ TEST_P(GpuAgreement, MatchesCpuReference) {
     if (c.traversal == snell::gpu::Traversal::RayQuery && !context().rayQueriesEnabled()) {
         // A driver without ray queries (Mesa 22.3's lavapipe) refuses them, saying why.
         try {
-            snell::ComputeRenderer refused(context(), scene, request.camera, c.precision, snell::gpu::BvhMode::Auto,
-                                           c.traversal);
+            snell::ComputeRenderer refused(context(), scene, request.camera,
+                                           {.precision = c.precision, .traversal = c.traversal});
             ADD_FAILURE() << "--traversal ray-query accepted on a device without ray queries";
         } catch (const snell::vk::VulkanError& e) {
             EXPECT_NE(std::string(e.what()).find("VK_KHR_"), std::string::npos) << e.what();
@@ -192,17 +192,16 @@ TEST_P(GpuAgreement, MatchesCpuReference) {
     }
     if (c.precision == snell::gpu::Precision::Fp64 && !context().fp64Refusal().empty()) {
         // A driver the fp64 shader renders wrong on refuses it, saying why.
-        EXPECT_THROW(snell::ComputeRenderer(context(), scene, request.camera, c.precision, snell::gpu::BvhMode::Auto,
-                                            c.traversal),
+        EXPECT_THROW(snell::ComputeRenderer(context(), scene, request.camera,
+                                            {.precision = c.precision, .traversal = c.traversal}),
                      snell::vk::VulkanError);
         return;
     }
-    snell::ComputeRenderer gpuRenderer(context(), scene, request.camera, c.precision, snell::gpu::BvhMode::Auto,
-                                       c.traversal);
+    snell::ComputeRenderer gpuRenderer(context(), scene, request.camera,
+                                       {.precision = c.precision, .traversal = c.traversal, .planAsGpu = c.gpuPlan});
     const bool bvh = scene.spheres.size() > snell::gpu::kBvhThreshold;
     EXPECT_STREQ(gpuRenderer.traversal(),
                  c.traversal == snell::gpu::Traversal::RayQuery ? "ray-query" : bvh ? "bvh" : "loop");
-    gpuRenderer.planAsGpu(c.gpuPlan);
     const snell::GpuRenderResult gpu = gpuRenderer.render(request, false);
     EXPECT_EQ(context().validationMessages(), messagesBefore) << "the Vulkan validation layer reported messages";
 

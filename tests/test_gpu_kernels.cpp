@@ -52,8 +52,7 @@ TEST_P(GpuSpecialisation, FoldedKernelTracesTheSameImage) {
     const fs::path modules = fs::path(context().cacheDirectory()) / "modules";
     const snell::Scene scene = snell::parseSceneFile(GetParam().file);
     const snell::RenderRequest request = wholeImage(scene, 48);
-    snell::ComputeRenderer driverSpecialised(context(), scene, request.camera);
-    driverSpecialised.foldSpecialisation(false);
+    snell::ComputeRenderer driverSpecialised(context(), scene, request.camera, {.foldSpecialisation = false});
     const snell::GpuRenderResult own = driverSpecialised.render(request, false);
     snell::ComputeRenderer folded(context(), scene, request.camera);
     const snell::GpuRenderResult image = folded.render(request, false);
@@ -96,12 +95,12 @@ TEST_P(GpuShaderObjects, KeptBinaryTracesThePipelinesImage) {
     const fs::path shaders = fs::path(cache.path()) / "shaders";
     const snell::Scene scene = snell::parseSceneFile(c.file);
     const snell::RenderRequest request = wholeImage(scene, 48);
-    snell::ComputeRenderer pipeline(objects, scene, request.camera, c.precision);
-    pipeline.useShaderObjects(false);
+    snell::ComputeRenderer pipeline(objects, scene, request.camera,
+                                    {.precision = c.precision, .useShaderObjects = false});
     const snell::GpuRenderResult own = pipeline.render(request, false);
     EXPECT_STREQ(pipeline.kernelObject(), "pipeline");
     for (const char* expected : {"shader object", "shader binary"}) {
-        snell::ComputeRenderer renderer(objects, scene, request.camera, c.precision);
+        snell::ComputeRenderer renderer(objects, scene, request.camera, {.precision = c.precision});
         const snell::GpuRenderResult image = renderer.render(request, false);
         EXPECT_STREQ(renderer.kernelObject(), support.enabled ? expected : "pipeline");
         ASSERT_EQ(image.image.rgb.size(), own.image.rgb.size());
@@ -128,7 +127,7 @@ TEST(GpuBvhWords, AddressReadsTraceTheTexelsImage) {
     requireTheSameWalk({{SNELL_SOURCE_DIR "/scenes/grid.scn", snell::gpu::Precision::Fp32},
                         {SNELL_SOURCE_DIR "/scenes/grid.scn", snell::gpu::Precision::Fp64},
                         {SNELL_SHARED_DIR "/course-scenes/becker-SphereFlake2.scn", snell::gpu::Precision::Fp32}},
-                       [](snell::ComputeRenderer& renderer, bool words) { renderer.readBvhWords(words); },
+                       [](snell::RendererOptions& options, bool words) { options.readBvhWords = words; },
                        "the BVH's two views");
 }
 
@@ -141,11 +140,10 @@ TEST(GpuBvhStack, RegistersTraceTheArraysImage) {
                         {SNELL_SOURCE_DIR "/scenes/grid.scn", snell::gpu::Precision::Fp64},
                         {SNELL_SHARED_DIR "/course-scenes/becker-SphereFlake2.scn", snell::gpu::Precision::Fp32},
                         {SNELL_SHARED_DIR "/course-scenes/becker-SphereFlake4.scn", snell::gpu::Precision::Fp32}},
-                       [](snell::ComputeRenderer& renderer, bool registers) {
-                           renderer.keepStackInRegisters(registers);
+                       [](snell::RendererOptions& options, bool registers) { options.stackInRegisters = registers; },
+                       "the two stacks", false, [](const snell::ComputeRenderer& renderer, bool registers) {
                            EXPECT_EQ(renderer.stackInRegisters(), registers);
-                       },
-                       "the two stacks");
+                       });
 }
 
 }  // namespace

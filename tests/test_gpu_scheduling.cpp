@@ -42,8 +42,8 @@ TEST_P(GpuResume, SuspendingNeverChangesTheImage) {
     const snell::RenderRequest request = wholeImage(scene, 24);
     snell::ComputeRenderer gpu(context(), scene, request.camera);
     const snell::GpuRenderResult whole = gpu.render(request, false);
-    gpu.forceLoopBudget(48);
-    const snell::GpuRenderResult resumed = gpu.render(request, false);
+    snell::ComputeRenderer budgeted(context(), scene, request.camera, {.loopBudget = 48});
+    const snell::GpuRenderResult resumed = budgeted.render(request, false);
     EXPECT_GT(resumed.dispatches, 2 * whole.dispatches) << "the budget forced too few suspensions to test";
     EXPECT_EQ(resumed.image.rgb, whole.image.rgb);
 }
@@ -209,12 +209,13 @@ TEST_P(GpuStacks, AddressesTraceTheStorageBuffersImage) {
     }
     std::vector<snell::Image> images;
     for (const bool byAddress : {false, true}) {
-        snell::ComputeRenderer renderer(context(), scene, request.camera, c.precision);
-        renderer.addressStacks(byAddress);
+        snell::ComputeRenderer renderer(context(), scene, request.camera,
+                                        {.precision = c.precision, .addressStacks = byAddress});
         const snell::GpuRenderResult whole = renderer.render(request, false);
         EXPECT_EQ(renderer.kernelAddressedStacks(), byAddress);
-        renderer.forceLoopBudget(48);
-        const snell::GpuRenderResult resumed = renderer.render(request, false);
+        snell::ComputeRenderer budgeted(context(), scene, request.camera,
+                                        {.precision = c.precision, .loopBudget = 48, .addressStacks = byAddress});
+        const snell::GpuRenderResult resumed = budgeted.render(request, false);
         EXPECT_GT(resumed.dispatches, 2 * whole.dispatches) << "the budget forced too few suspensions to test";
         ASSERT_EQ(whole.image.rgb.size(), std::size_t(3 * size * size));
         ASSERT_EQ(resumed.image.rgb.size(), whole.image.rgb.size());
@@ -249,8 +250,7 @@ TEST(GpuShadowRays, SharedTraceTheOwnRaysImage) {
     // elsewhere both renders would run the same kernel.
     {
         const snell::Scene grid = snell::parseSceneFile(SNELL_SOURCE_DIR "/scenes/grid.scn");
-        snell::ComputeRenderer probe(context(), grid, wholeImage(grid, 8).camera);
-        probe.shareShadowRays(true);
+        const snell::ComputeRenderer probe(context(), grid, wholeImage(grid, 8).camera, {.shareShadowRays = true});
         if (!probe.sharesShadowRays())
             SNELL_CANNOT_TEST_HERE("this device does not share shadow rays out (" + context().deviceName() +
                                    ", subgroups of " + std::to_string(context().subgroupSize()) +
@@ -261,12 +261,11 @@ TEST(GpuShadowRays, SharedTraceTheOwnRaysImage) {
                         {SNELL_SOURCE_DIR "/scenes/grid.scn", snell::gpu::Precision::Fp64},
                         {SNELL_SOURCE_DIR "/scenes/hard/lights-over-glass-bvh.scn", snell::gpu::Precision::Fp32},
                         {SNELL_SHARED_DIR "/course-scenes/becker-SphereFlake2.scn", snell::gpu::Precision::Fp32}},
-                       [](snell::ComputeRenderer& renderer, bool share) {
-                           renderer.shareShadowRays(share);
+                       [](snell::RendererOptions& options, bool share) { options.shareShadowRays = share; },
+                       "shared and own shadow rays", true, [](const snell::ComputeRenderer& renderer, bool share) {
                            // The setting took: the two renders run different kernels.
                            EXPECT_EQ(renderer.sharesShadowRays(), share);
-                       },
-                       "shared and own shadow rays", true);
+                       });
 }
 
 // A GPU's plan (thousands of workgroups taking the tile's shares, helping
@@ -288,8 +287,8 @@ TEST(GpuPlan, TracesTheImageOfLavapipesPlan) {
         request.trace.tolerance = 0.0;
         snell::ComputeRenderer gpu(context(), scene, request.camera);
         const snell::GpuRenderResult own = gpu.render(request, false);
-        gpu.planAsGpu(true);
-        const snell::GpuRenderResult planned = gpu.render(request, false);
+        snell::ComputeRenderer asGpu(context(), scene, request.camera, {.planAsGpu = true});
+        const snell::GpuRenderResult planned = asGpu.render(request, false);
         // The plan took: a GPU's has many more invocations than lavapipe's.
         EXPECT_LT(own.invocations, planned.invocations);
         // grid: more shares than 32 words of bits, so the words' bits span words too.

@@ -19,6 +19,50 @@ struct BuildTask {
     int depth;
 };
 
+struct Split {
+    double cost = 1e308;  // the surface area heuristic's, before the constants
+    int axis = -1, bin = 0;  // axis -1: no axis has centroids apart
+};
+
+// Best split over the binned centroids on every axis.
+Split bestSplit(const std::vector<Aabb>& primitives, const std::vector<glm::dvec3>& centroid,
+                const std::vector<std::uint32_t>& order, const BuildTask& task, const Aabb& centroidBounds) {
+    Split best;
+    for (int axis = 0; axis < 3; ++axis) {
+        const double lo = centroidBounds.lower[axis], hi = centroidBounds.upper[axis];
+        if (!(hi > lo)) continue;
+        const double toBin = kBins / (hi - lo);
+        std::array<Aabb, kBins> binBounds{};
+        std::array<std::uint32_t, kBins> binCount{};
+        for (std::uint32_t i = task.begin; i < task.end; ++i) {
+            const std::uint32_t p = order[i];
+            const int b = std::min(kBins - 1, static_cast<int>((centroid[p][axis] - lo) * toBin));
+            binBounds[b].grow(primitives[p]);
+            ++binCount[b];
+        }
+        std::array<double, kBins> rightArea{};
+        std::array<std::uint32_t, kBins> rightCount{};
+        Aabb acc;
+        std::uint32_t accCount = 0;
+        for (int b = kBins - 1; b > 0; --b) {
+            acc.grow(binBounds[b]);
+            accCount += binCount[b];
+            rightArea[b] = acc.halfArea();
+            rightCount[b] = accCount;
+        }
+        acc = Aabb{};
+        accCount = 0;
+        for (int b = 0; b < kBins - 1; ++b) {
+            acc.grow(binBounds[b]);
+            accCount += binCount[b];
+            if (accCount == 0 || rightCount[b + 1] == 0) continue;
+            const double cost = acc.halfArea() * accCount + rightArea[b + 1] * rightCount[b + 1];
+            if (cost < best.cost) best = {cost, axis, b};
+        }
+    }
+    return best;
+}
+
 }  // namespace
 
 Bvh buildBvh(const std::vector<Aabb>& primitives, std::uint32_t maxLeafSize) {
@@ -48,41 +92,10 @@ Bvh buildBvh(const std::vector<Aabb>& primitives, std::uint32_t maxLeafSize) {
         };
         if (count <= 1) { makeLeaf(); continue; }
 
-        // Best split over the binned centroids on every axis.
-        double bestCost = 1e308;
-        int bestAxis = -1, bestBin = 0;
-        for (int axis = 0; axis < 3; ++axis) {
-            const double lo = centroidBounds.lower[axis], hi = centroidBounds.upper[axis];
-            if (!(hi > lo)) continue;
-            const double toBin = kBins / (hi - lo);
-            std::array<Aabb, kBins> binBounds{};
-            std::array<std::uint32_t, kBins> binCount{};
-            for (std::uint32_t i = task.begin; i < task.end; ++i) {
-                const std::uint32_t p = bvh.order[i];
-                const int b = std::min(kBins - 1, static_cast<int>((centroid[p][axis] - lo) * toBin));
-                binBounds[b].grow(primitives[p]);
-                ++binCount[b];
-            }
-            std::array<double, kBins> rightArea{};
-            std::array<std::uint32_t, kBins> rightCount{};
-            Aabb acc;
-            std::uint32_t accCount = 0;
-            for (int b = kBins - 1; b > 0; --b) {
-                acc.grow(binBounds[b]);
-                accCount += binCount[b];
-                rightArea[b] = acc.halfArea();
-                rightCount[b] = accCount;
-            }
-            acc = Aabb{};
-            accCount = 0;
-            for (int b = 0; b < kBins - 1; ++b) {
-                acc.grow(binBounds[b]);
-                accCount += binCount[b];
-                if (accCount == 0 || rightCount[b + 1] == 0) continue;
-                const double cost = acc.halfArea() * accCount + rightArea[b + 1] * rightCount[b + 1];
-                if (cost < bestCost) { bestCost = cost; bestAxis = axis; bestBin = b; }
-            }
-        }
+        const Split best = bestSplit(primitives, centroid, bvh.order, task, centroidBounds);
+        const double bestCost = best.cost;
+        int bestAxis = best.axis;
+        const int bestBin = best.bin;
         const double parentArea = bounds.halfArea();
         const double leafCost = kIntersectionCost * count;
         const double splitCost =

@@ -421,10 +421,12 @@ RenderOutcome RenderCommand::renderOnGpu(const Scene& scene, RenderRequest& requ
         options.pipelineCachePath = pipelineCachePath();
         vk::Context context(options);
         stream.encodeBeside(context.properties().deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU);
-        ComputeRenderer renderer(context, scene, request.camera, o_.device.arithmetic(), gpu::BvhMode::Auto,
-                                 o_.device.search());
-        if (const std::uint32_t budget = loopBudgetOverride()) renderer.forceLoopBudget(budget);
-        renderer.countLanes(o_.countLanes);
+        RendererOptions rendererOptions;
+        rendererOptions.precision = o_.device.arithmetic();
+        rendererOptions.traversal = o_.device.search();
+        if (const std::uint32_t budget = loopBudgetOverride()) rendererOptions.loopBudget = budget;
+        rendererOptions.countLanes = o_.countLanes;
+        ComputeRenderer renderer(context, scene, request.camera, rendererOptions);
         // The probe compiles the pipeline, which belongs to pipelineMs: the
         // render's own (the same specialisation, counting rays only as the
         // render does), so the render reuses it rather than compiling a second

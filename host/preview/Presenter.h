@@ -33,6 +33,7 @@ private:
     void createSwapchain();
     void destroySwapchain();
     void ensureSource(int width, int height);
+    void recordBlit(VkCommandBuffer cmd, VkImage target, int width, int height);
 
     vk::Context& context_;
     GLFWwindow* window_;
@@ -48,7 +49,7 @@ private:
     VkCommandBuffer commands_ = VK_NULL_HANDLE;
     // The image to show, staged in host memory and copied to a device image.
     vk::Buffer staging_;
-    vk::StorageImage source_;
+    vk::DeviceImage source_;
 };
 
 }  // namespace snell

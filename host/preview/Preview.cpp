@@ -133,6 +133,8 @@ private:
     void reload();
     void reloadIfChanged();
     void reportReload();
+    // Renders and shows frames until the window closes (or the scripted frames are shown).
+    void showFrames();
     void printFrameTimes(int framesShown, const std::vector<double>& renderMs, const std::vector<double>& frameMs) const;
     void handleKeys();
     void renderFrame();
@@ -178,8 +180,10 @@ void Session::loadScene(std::unique_ptr<Scene> scene) {
     const bool keepCamera = scene_ && !camera_.atHome();
     size_ = o_.size.value_or(scene->imageSize);
     const Camera home = Camera::fromSpec(size_, scene->halfWidth);
-    auto renderer = std::make_unique<ComputeRenderer>(*context_, *scene, home, o_.precision, gpu::BvhMode::Auto,
-                                                      o_.traversal);
+    RendererOptions options;
+    options.precision = o_.precision;
+    options.traversal = o_.traversal;
+    auto renderer = std::make_unique<ComputeRenderer>(*context_, *scene, home, options);
     renderer_ = std::move(renderer);  // the old renderer goes before its scene
     scene_ = std::move(scene);
     if (!keepCamera) camera_ = OrbitCamera(*scene_, home, scene_->halfWidth);
@@ -386,46 +390,7 @@ void Session::printFrameTimes(int framesShown, const std::vector<double>& render
               << " ms a frame in all (" << 1000.0 / median(frameMs) << " frames a second)\n";
 }
 
-void Session::run() {
-    auto first = std::make_unique<Scene>(parseSceneFile(o_.scene));  // ParseError: the caller's
-    if (!o_.quiet)
-        for (const Diagnostic& w : first->warnings) std::cerr << w.format("warning") << "\n";
-    sceneTime_ = modificationTime(o_.scene);
-    supersampleOn_ = o_.supersample.value_or(first->supersample) > 1;
-    if (o_.depth) trace_.maxDepth = *o_.depth;
-    if (o_.minWeight) trace_.minWeight = *o_.minWeight;
-
-    initGlfw();
-    struct Terminate {
-        GLFWwindow*& window;
-        ~Terminate() {
-            if (window) glfwDestroyWindow(window);
-            glfwTerminate();
-        }
-    } terminate{window_};
-
-    const int side = o_.size.value_or(first->imageSize);
-    const int windowSide = std::min(side, 1024);  // larger images are shown scaled down
-    glfwWindowHint(GLFW_CLIENT_API, GLFW_NO_API);
-    window_ = glfwCreateWindow(windowSide, windowSide, "snell preview", nullptr, nullptr);
-    if (!window_) throw WindowError("GLFW could not create a window");
-
-    context_ = std::make_unique<vk::Context>(contextOptions());
-    struct Release {  // Vulkan objects go before the window and GLFW
-        Session& s;
-        ~Release() {
-            s.presenter_.reset();
-            s.renderer_.reset();
-            s.context_.reset();
-        }
-    } release{*this};
-    presenter_ = std::make_unique<Presenter>(*context_, window_);
-    loadScene(std::move(first));
-    if (o_.orbitDegrees != 0.0) camera_.orbitDegrees(o_.orbitDegrees);
-
-    connectInput();
-    updateTitle();
-
+void Session::showFrames() {
     int framesShown = 0;
     std::vector<double> renderMs, frameMs;  // per shown frame: the dispatches, and the whole loop
     Clock::time_point lastShown = Clock::now();
@@ -478,6 +443,49 @@ void Session::run() {
         }
     }
     if (o_.frames > 0 && !o_.quiet && !frameMs.empty()) printFrameTimes(framesShown, renderMs, frameMs);
+}
+
+void Session::run() {
+    auto first = std::make_unique<Scene>(parseSceneFile(o_.scene));  // ParseError: the caller's
+    if (!o_.quiet)
+        for (const Diagnostic& w : first->warnings) std::cerr << w.format("warning") << "\n";
+    sceneTime_ = modificationTime(o_.scene);
+    supersampleOn_ = o_.supersample.value_or(first->supersample) > 1;
+    if (o_.depth) trace_.maxDepth = *o_.depth;
+    if (o_.minWeight) trace_.minWeight = *o_.minWeight;
+
+    initGlfw();
+    struct Terminate {
+        GLFWwindow*& window;
+        ~Terminate() {
+            if (window) glfwDestroyWindow(window);
+            glfwTerminate();
+        }
+    } terminate{window_};
+
+    const int side = o_.size.value_or(first->imageSize);
+    const int windowSide = std::min(side, 1024);  // larger images are shown scaled down
+    glfwWindowHint(GLFW_CLIENT_API, GLFW_NO_API);
+    window_ = glfwCreateWindow(windowSide, windowSide, "snell preview", nullptr, nullptr);
+    if (!window_) throw WindowError("GLFW could not create a window");
+
+    context_ = std::make_unique<vk::Context>(contextOptions());
+    struct Release {  // Vulkan objects go before the window and GLFW
+        Session& s;
+        ~Release() {
+            s.presenter_.reset();
+            s.renderer_.reset();
+            s.context_.reset();
+        }
+    } release{*this};
+    presenter_ = std::make_unique<Presenter>(*context_, window_);
+    loadScene(std::move(first));
+    if (o_.orbitDegrees != 0.0) camera_.orbitDegrees(o_.orbitDegrees);
+
+    connectInput();
+    updateTitle();
+
+    showFrames();
     if (o_.validation && context_->validationMessages() > 0)
         throw vk::VulkanError("the Vulkan validation layer reported " +
                               std::to_string(context_->validationMessages()) + " message(s)");

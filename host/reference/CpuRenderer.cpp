@@ -412,7 +412,7 @@ void CpuRenderer::followChildren(const PendingRay& r, const Hit& hit, double cut
     if (worthTracing(c.reflected.weight, cutOff)) reflectedRay = std::move(c.reflected);
     else tree.defer(std::move(c.reflected), settings);
     // The lighter child is traced next and the heavier waits (as the
-    // shader does, whose stack this bounds: ComputeRenderer.cpp); in an
+    // shader does, whose stack this bounds: gpu/KernelPolicy.cpp); in an
     // amplifying scene the heavier goes first, so that a tree budget is
     // spent on the weightiest rays, those that saturate a diverging channel.
     if (reflectedRay && refractedRay &&

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cstring>
 
-#include "common/Clock.h"
 
 namespace snell::vk {
 
@@ -25,7 +24,6 @@ BoxAccelerationStructure::BoxAccelerationStructure(Context& context, const void*
     : context_(context) {
     if (!context.rayQueriesEnabled())
         throw VulkanError("internal error: an acceleration structure on a device without ray queries");
-    const auto start = Clock::now();
     VkDevice device = context.device();
     getBuildSizes_ = deviceFunction<PFN_vkGetAccelerationStructureBuildSizesKHR>(
         device, "vkGetAccelerationStructureBuildSizesKHR");
@@ -65,7 +63,6 @@ BoxAccelerationStructure::BoxAccelerationStructure(Context& context, const void*
     // The inputs are read by the builds alone.
     context.destroy(boxes_);
     context.destroy(instances_);
-    buildMs_ = msSince(start);
 }
 
 // Sizes, storage and a build of one level, waited for.

@@ -20,8 +20,6 @@ public:
 
     // The top level, for a VK_DESCRIPTOR_TYPE_ACCELERATION_STRUCTURE_KHR binding.
     const VkAccelerationStructureKHR& top() const { return top_; }
-    double buildMs() const { return buildMs_; }
-    VkDeviceSize bytes() const { return bottomBuffer_.size + topBuffer_.size; }
 
 private:
     VkAccelerationStructureKHR build(const VkAccelerationStructureGeometryKHR& geometry,
@@ -36,7 +34,6 @@ private:
     PFN_vkGetAccelerationStructureDeviceAddressKHR getAddress_ = nullptr;
     Buffer boxes_, instances_, bottomBuffer_, topBuffer_;
     VkAccelerationStructureKHR bottom_ = VK_NULL_HANDLE, top_ = VK_NULL_HANDLE;
-    double buildMs_ = 0.0;
 };
 
 }  // namespace snell::vk

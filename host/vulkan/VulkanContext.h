@@ -56,7 +56,8 @@ FaultInjection parseFaultInjection(const std::string& text);
 // Whether the device's own ray traversal (VK_KHR_ray_query over
 // VK_KHR_acceleration_structure, with buffer device addresses) is enabled
 // where the device has it: never, on GPUs only (the default: on lavapipe,
-// snell's BVH walk measured faster; docs/performance.md), or on any device.
+// snell's BVH walk measured faster; docs/performance.md, "Drivers and
+// devices"), or on any device.
 enum class RayQueries { Off, OnGpus, On };
 
 struct ContextOptions {
@@ -94,10 +95,10 @@ struct Buffer {
     void* mapped = nullptr;  // host-visible buffers stay mapped
 };
 
-struct StorageImage {
+// A device-local 2D image (the preview's frame, copied and blitted).
+struct DeviceImage {
     VkImage image = VK_NULL_HANDLE;
     VkDeviceMemory memory = VK_NULL_HANDLE;
-    VkImageView view = VK_NULL_HANDLE;
     std::uint32_t width = 0, height = 0;
 };
 
@@ -141,7 +142,6 @@ public:
     int mesaMajor() const;
     // Validation-layer errors and warnings reported so far.
     std::uint32_t validationMessages() const { return validationMessages_; }
-    const std::vector<DeviceReport>& deviceReports() const { return reports_; }
 
     // Where a buffer lives. A usage with VK_BUFFER_USAGE_SHADER_DEVICE_ADDRESS_BIT
     // gets memory that has one (deviceAddress).
@@ -158,10 +158,9 @@ public:
     Buffer createBufferWithData(const void* bytes, VkDeviceSize size, VkBufferUsageFlags usage);
     void destroy(Buffer& buffer);
     VkDeviceAddress deviceAddress(const Buffer& buffer) const;
-    StorageImage createStorageImage(std::uint32_t width, std::uint32_t height, VkFormat format);
-    // A device-local 2D image with a view, for any usage.
-    StorageImage createImage(std::uint32_t width, std::uint32_t height, VkFormat format, VkImageUsageFlags usage);
-    void destroy(StorageImage& image);
+    // A device-local 2D image, for transfers (no view).
+    DeviceImage createImage(std::uint32_t width, std::uint32_t height, VkFormat format, VkImageUsageFlags usage);
+    void destroy(DeviceImage& image);
 
     // The pipeline cache (VK_NULL_HANDLE when none could be made).
     VkPipelineCache pipelineCache() const { return pipelineCache_; }

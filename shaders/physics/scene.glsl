@@ -4,7 +4,7 @@
 #ifndef SNELL_PHYSICS_SCENE_GLSL
 #define SNELL_PHYSICS_SCENE_GLSL
 
-// What this scene uses (host/gpu/ComputeRenderer.cpp sets them): code for a
+// What this scene uses (host/gpu/KernelPolicy.cpp sets them): code for a
 // feature the scene lacks is dead and removed when the pipeline is compiled.
 layout(constant_id = SNELL_SPEC_USE_BVH) const bool USE_BVH = false;
 // Without a BVH and at most SNELL_MAX_UNROLLED_SPHERES spheres: their number,

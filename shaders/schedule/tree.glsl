@@ -98,7 +98,7 @@ bool followChildren(uint slot, inout SlotState state, inout Ray r, vec3 weight, 
     // Both children: the lighter is traced next and the heavier waits on the
     // stack, so each waiting ray at least halves (ks + kt <= 1) the weight of
     // the path below it, and the stack needs no more than log(cut-off) / log(q)
-    // entries however deep the tree (host/gpu/ComputeRenderer.cpp sizes it).
+    // entries however deep the tree (host/gpu/KernelPolicy.cpp sizes it).
     // In an amplifying scene (where the stack is sized by depth anyway) the
     // heavier goes on instead: under a tree budget the weightiest rays are
     // traced first, which is what saturates a diverging channel.

@@ -1,0 +1,17 @@
+// Readback: a finished tile, from where the kernel wrote it, into the image
+// (or the band of rows being streamed), with each pixel's truncation bound.
+#pragma once
+
+#include "gpu/GpuRenderResult.h"
+#include "gpu/ProgressForecast.h"
+#include "gpu/TilePlan.h"
+
+namespace snell::gpu {
+
+// `rows` is the image, or the band being streamed, whose first row is
+// `firstRow` of the window; also fills the request's bound and ray images.
+void readBackTile(const OutputPixel* pixels, const RenderRequest& request, const TilePlan& plan,
+                  const TileParams& tile, Image& rows, int firstRow, RenderProgress& progress,
+                  GpuRenderResult& result);
+
+}  // namespace snell::gpu
