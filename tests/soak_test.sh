@@ -10,14 +10,15 @@
 # every dispatch: an early one that wrote pixels through a storage image, and
 # one it specialised on a uniform value (docs/design.md, No recompiles per
 # dispatch); either would grow by hundreds of MB here. The render is then
-# ended with SIGTERM and must exit 143, leaving no file.
+# ended with SIGTERM and must exit 143, leaving no file. Given SECOND_ICD, a
+# second render on that driver runs beside the first.
 set -u
 : "${SNELL:?}"
 seconds=${SOAK_SECONDS:-120}
 settle=${SOAK_SETTLE:-20}
 growth=${SOAK_GROWTH_MB:-8}
 work=$(mktemp -d)
-trap 'kill -9 $pid 2>/dev/null; rm -rf "$work"' EXIT
+trap 'pkill -9 -f "$work/trapped.scn" 2>/dev/null; rm -rf "$work"' EXIT
 cat >"$work/trapped.scn" <<'SCENE'
 view 64 0.5
 background 0.1 0.2 0.6
@@ -31,24 +32,41 @@ move 0.6 0.6 -3
 scale 0.7 0.7 0.7
 sphere
 SCENE
-"$SNELL" render "$work/trapped.scn" -q --size 48 --tolerance 0 --min-weight 0 --depth 200 --tree-budget 1000000000 \
-  -o "$work/out.png" 2>"$work/err" &
-pid=$!
-samples=()
-for ((t = 0; t < seconds; t += 2)); do
-  sleep 2
-  rss=$(ps -o rss= -p $pid 2>/dev/null) || { echo "FAIL: the render ended early: $(cat "$work/err")"; exit 1; }
-  samples+=("$t $((rss / 1024))")
-done
-kill -TERM $pid
-wait $pid; status=$?
-printf '%s\n' "${samples[@]}" >"$work/rss"
-echo "resident MB over time (s MB): $(tr '\n' ';' <"$work/rss")"
-base=$(awk -v s="$settle" '$1 >= s { print $2; exit }' "$work/rss")
-peak=$(awk -v s="$settle" '$1 >= s && $2 > m { m = $2 } END { print m }' "$work/rss")
+# soak NAME [ENV...]: one render on the driver ENV names, sampled and ended;
+# prints its findings, exits non-zero on a failure.
+soak() {
+  local name=$1 dir="$work/$1" pid status samples=() t rss base peak fail=0
+  shift
+  mkdir -p "$dir"
+  env "$@" "$SNELL" render "$work/trapped.scn" -q --size 48 --tolerance 0 --min-weight 0 --depth 200 \
+    --tree-budget 1000000000 -o "$dir/out.png" 2>"$dir/err" &
+  pid=$!
+  for ((t = 0; t < seconds; t += 2)); do
+    sleep 2
+    rss=$(ps -o rss= -p $pid 2>/dev/null) || { echo "FAIL ($name): the render ended early: $(cat "$dir/err")"; return 1; }
+    samples+=("$t $((rss / 1024))")
+  done
+  kill -TERM $pid
+  wait $pid; status=$?
+  printf '%s\n' "${samples[@]}" >"$dir/rss"
+  echo "$name: resident MB over time (s MB): $(tr '\n' ';' <"$dir/rss")"
+  base=$(awk -v s="$settle" '$1 >= s { print $2; exit }' "$dir/rss")
+  peak=$(awk -v s="$settle" '$1 >= s && $2 > m { m = $2 } END { print m }' "$dir/rss")
+  [ "$status" -eq 143 ] || { echo "FAIL ($name): SIGTERM gave status $status (want 143)"; fail=1; }
+  [ ! -e "$dir/out.png" ] && [ -z "$(ls "$dir" | grep tmp)" ] || { echo "FAIL ($name): a file was left behind"; fail=1; }
+  [ $((peak - base)) -le "$growth" ] || { echo "FAIL ($name): resident size grew from $base MB to $peak MB after ${settle} s"; fail=1; }
+  [ $fail -eq 0 ] && echo "$name: $seconds s, resident $base -> $peak MB after ${settle} s"
+  return $fail
+}
+
+# The system's driver and, given SECOND_ICD, the second lavapipe side by side:
+# each dispatches at half the pace, and a leak grows by the dispatch.
+soak system & first=$!
+second=
+if [ -n "${SECOND_ICD:-}" ]; then
+  soak second-lavapipe VK_DRIVER_FILES="$SECOND_ICD" & second=$!
+fi
 fail=0
-[ "$status" -eq 143 ] || { echo "FAIL: SIGTERM gave status $status (want 143)"; fail=1; }
-[ ! -e "$work/out.png" ] && [ -z "$(ls "$work" | grep tmp)" ] || { echo "FAIL: a file was left behind"; fail=1; }
-[ $((peak - base)) -le "$growth" ] || { echo "FAIL: resident size grew from $base MB to $peak MB after ${settle} s"; fail=1; }
-[ $fail -eq 0 ] && echo "soak: $seconds s, resident $base -> $peak MB after ${settle} s"
+wait $first || fail=1
+if [ -n "$second" ]; then wait $second || fail=1; fi
 exit $fail
