@@ -29,6 +29,24 @@ void splitDouble(double v, out float hi, out float lo) {
 void splitDouble(dvec3 v, out vec3 hi, out vec3 lo) {
     for (int k = 0; k < 3; ++k) splitDouble(v[k], hi[k], lo[k]);
 }
+// v as three floats, hi + mid + lo, exactly (24 + 24 + 5 of its 53 bits, as
+// long as lo is within float's range): the split above, then the same split
+// of its remainder v − hi, which has at most 29 bits. A ray that waits in a
+// stack comes back as the very ray that was stored, so a render does not
+// depend on which rays waited.
+void splitDoubleExact(double v, out float hi, out float mid, out float lo) {
+    precise double c = 536870913.0LF * v;
+    precise double h = c - (c - v);
+    precise double r = v - h;  // exact
+    precise double d = 536870913.0LF * r;
+    precise double m = d - (d - r);
+    hi = float(h);
+    mid = float(m);
+    lo = float(r - m);  // exact: at most 5 bits
+}
+void splitDoubleExact(dvec3 v, out vec3 hi, out vec3 mid, out vec3 lo) {
+    for (int k = 0; k < 3; ++k) splitDoubleExact(v[k], hi[k], mid[k], lo[k]);
+}
 #else
 #define real float
 #define rvec2 vec2

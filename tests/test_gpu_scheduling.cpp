@@ -185,7 +185,9 @@ TEST(GpuTiles, InterleavedTilesGiveTheImageOfBlocks) {
 // where the invocations suspend mid-tree and the stacks carry their rays from
 // one dispatch to the next; nested media (glass in water), amplifying trees
 // (becker-1n), a BVH, the fp64 kernel (its low parts stay in a storage
-// buffer), and the deepest stack of a fixed tree without a cut-off.
+// buffer; a waiting ray's doubles come back exact, so its deep trees do not
+// change where they wait), and the deepest stack of a fixed tree without a
+// cut-off.
 struct StackCase {
     const char* name;
     const char* file;
@@ -233,6 +235,8 @@ INSTANTIATE_TEST_SUITE_P(
                               snell::gpu::Precision::Fp32, false},
                     StackCase{"becker_1n", SNELL_SHARED_DIR "/course-scenes/becker-1n.scn",
                               snell::gpu::Precision::Fp32, false},
+                    StackCase{"becker_1n_fp64", SNELL_SHARED_DIR "/course-scenes/becker-1n.scn",
+                              snell::gpu::Precision::Fp64, false},
                     StackCase{"grid", SNELL_SOURCE_DIR "/scenes/grid.scn", snell::gpu::Precision::Fp32, false},
                     StackCase{"bench_glass_fixed_tree", SNELL_SHARED_DIR "/bench-scenes/glass.scn",
                               snell::gpu::Precision::Fp32, true}),

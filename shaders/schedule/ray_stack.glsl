@@ -75,11 +75,14 @@ uint loadMedium(uint i) {
 
 void storeRay(uint entry, Ray r) {
 #ifdef SNELL_FP64
-    vec3 origin, originLow, dir, dirLow;
-    splitDouble(r.origin, origin, originLow);
-    splitDouble(r.dir, dir, dirLow);
-    rayStackLow[entry].origin = vec4(originLow, 0.0);
-    rayStackLow[entry].direction = vec4(dirLow, 0.0);
+    // The low entry holds the two lower parts of each double: origin and
+    // direction the middle ones, weight.xyz and the w's the last ones.
+    vec3 origin, originMid, originLow, dir, dirMid, dirLow;
+    splitDoubleExact(r.origin, origin, originMid, originLow);
+    splitDoubleExact(r.dir, dir, dirMid, dirLow);
+    rayStackLow[entry].origin = vec4(originMid, dirLow.x);
+    rayStackLow[entry].direction = vec4(dirMid, dirLow.y);
+    rayStackLow[entry].weight = vec4(originLow, dirLow.z);
 #else
     vec3 origin = r.origin, dir = r.dir;
 #endif
@@ -94,8 +97,14 @@ Ray loadRay(uint entry) {
     uint mediaCount = p.flags >> 1;
     [[unroll]] for (int k = 0; k < MAX_MEDIA; ++k)
         if (uint(k) < mediaCount) media[k] = loadMedium(entry * uint(MAX_MEDIA) + uint(k));
-    return Ray(WIDE(p.origin, rayStackLow[entry].origin).xyz, WIDE(p.direction, rayStackLow[entry].direction).xyz,
-               p.weight.rgb, p.depth, p.fromSphere, (p.flags & 1u) != 0u, mediaCount, p.resumeShading);
+#ifdef SNELL_FP64
+    PendingRay low = rayStackLow[entry];
+    precise dvec3 origin = (dvec3(p.origin.xyz) + dvec3(low.origin.xyz)) + dvec3(low.weight.xyz);
+    precise dvec3 dir = (dvec3(p.direction.xyz) + dvec3(low.direction.xyz)) + dvec3(low.origin.w, low.direction.w, low.weight.w);
+#else
+    vec3 origin = p.origin.xyz, dir = p.direction.xyz;
+#endif
+    return Ray(origin, dir, p.weight.rgb, p.depth, p.fromSphere, (p.flags & 1u) != 0u, mediaCount, p.resumeShading);
 }
 
 void pushRay(uint slot, inout uint pending, Ray r) {
