@@ -22,10 +22,11 @@ check() {  # check FILE EXPECTATION... (each "LINE COL TEXT")
   if [ $status -ne 2 ]; then
     echo "FAIL: $file: exit status $status, want 2 ($first)"; fail=$((fail + 1)); return
   fi
-  # The report's lines: those that start with the file's name.
+  # The report's errors: the lines that start with the file's name (its
+  # warnings, among them by line, aside).
   local reported=() l
   while IFS= read -r l; do
-    case "$l" in "$file:"*) reported+=("$l") ;; esac
+    case "$l" in "$file:"*": warning: "*) ;; "$file:"*) reported+=("$l") ;; esac
   done <"$work/stderr"
   if [ ${#reported[@]} -ne $# ]; then
     echo "FAIL: $file: ${#reported[@]} error lines, want $#:"; sed 's/^/  /' "$work/stderr"

@@ -3,11 +3,15 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <istream>
 #include <map>
+#include <sstream>
+#include <streambuf>
 #include <string>
 #include <vector>
 
 #include "parser_test_support.h"
+#include "scene/SceneReader.h"
 
 namespace {
 
@@ -151,6 +155,18 @@ TEST(Parser, UnclosedGroupIsAWarningNotAnError) {
     EXPECT_NE(s.warnings[0].message.find("group"), std::string::npos);
 }
 
+TEST(Parser, ManyUnclosedGroupsAreCounted) {
+    // The outermost ten, then one warning for the rest, at the first of them.
+    std::string text = kView;
+    for (int i = 0; i < 4000; ++i) text += "group\n";
+    const Scene s = parse(text);
+    ASSERT_EQ(s.warnings.size(), 11u);
+    EXPECT_EQ(s.warnings[9].location.line, 11);
+    EXPECT_EQ(s.warnings[10].location.line, 12);
+    EXPECT_NE(s.warnings[10].message.find("the 3989 opened after it are never closed"), std::string::npos)
+        << s.warnings[10].message;
+}
+
 TEST(Parser, NumberForms) {
     // SPEC §1: 1, -0.5, +.5, 5., 2e-3, 2E-3.
     const Scene s = parse(kView + "light 1 0 0.5 -0.5 +.5 5.\nlight 2e-3 2E-3 1e+2 -1E2 0 +0\n");
@@ -206,6 +222,157 @@ TEST(Parser, TrailingSpacesAllowed) {
 TEST(Parser, ValidUtf8InCommentAccepted) {
     const Scene s = parse(kView + "# caf\xc3\xa9 \xe2\x82\xac \xf0\x9f\x98\x80\nsphere\n");
     EXPECT_EQ(s.spheres.size(), 1u);
+}
+
+// ---------------------------------------------------------------- input
+
+using snell::ReadEnd;
+using snell::SceneReader;
+
+std::vector<std::string> linesOf(SceneReader& reader) {
+    std::vector<std::string> lines;
+    for (std::string_view line; reader.next(line);) lines.emplace_back(line);
+    return lines;
+}
+
+// An endless stream of one byte, as /dev/zero or an endless pipe.
+class Endless : public std::streambuf {
+public:
+    explicit Endless(char c) : block_(4096, c) {}
+
+private:
+    int_type underflow() override {
+        setg(block_.data(), block_.data(), block_.data() + block_.size());
+        return traits_type::to_int_type(block_[0]);
+    }
+    std::string block_;
+};
+
+constexpr snell::ReadLimits kSmall{1'000'000, 100};
+
+TEST(SceneReader, StreamAndTextGiveTheSameLines) {
+    // Lines across the stream's chunks (64 KiB), CR LF, a last line without LF.
+    std::string text;
+    for (int i = 0; i < 20000; ++i) text += "line " + std::to_string(i) + (i % 3 ? "\n" : "\r\n");
+    text += "last";
+    SceneReader fromText(text, kSmall);
+    std::istringstream in(text);
+    SceneReader fromStream(in, kSmall);
+    const std::vector<std::string> lines = linesOf(fromText);
+    ASSERT_EQ(lines.size(), 20001u);
+    EXPECT_EQ(lines[0], "line 0");
+    EXPECT_EQ(lines[19999], "line 19999");
+    EXPECT_EQ(lines[20000], "last");
+    EXPECT_EQ(linesOf(fromStream), lines);
+    EXPECT_EQ(fromText.end(), ReadEnd::EndOfInput);
+    EXPECT_EQ(fromStream.end(), ReadEnd::EndOfInput);
+}
+
+TEST(SceneReader, StopsAtTheFirstNulByte) {
+    // /dev/zero: its first byte is the last read.
+    Endless zeros('\0');
+    std::istream in(&zeros);
+    SceneReader endless(in, kSmall);
+    EXPECT_EQ(linesOf(endless), std::vector<std::string>{std::string(1, '\0')});
+    EXPECT_EQ(endless.end(), ReadEnd::NulByte);
+    EXPECT_EQ(endless.lineNumber(), 1);
+    // The line holding it ends at it; no line after it is read.
+    const std::string withNul = "ab\ncd\0ef\ngh\n"s;
+    SceneReader text(withNul, kSmall);
+    EXPECT_EQ(linesOf(text), (std::vector<std::string>{"ab", "cd\0"s}));
+    EXPECT_EQ(text.end(), ReadEnd::NulByte);
+    EXPECT_EQ(text.lineNumber(), 2);
+}
+
+TEST(SceneReader, StopsAtALineLongerThanTheLimit) {
+    Endless xs('x');
+    std::istream in(&xs);
+    SceneReader endless(in, kSmall);
+    EXPECT_TRUE(linesOf(endless).empty());
+    EXPECT_EQ(endless.end(), ReadEnd::LineTooLong);
+    EXPECT_EQ(endless.lineNumber(), 1);
+    // 100 bytes are a line, 101 are not (its CR counts).
+    const std::string text = "ab\n" + std::string(100, 'x') + "\n" + std::string(100, 'y') + "\r\nok\n";
+    SceneReader reader(text, kSmall);
+    EXPECT_EQ(linesOf(reader), (std::vector<std::string>{"ab", std::string(100, 'x')}));
+    EXPECT_EQ(reader.end(), ReadEnd::LineTooLong);
+    EXPECT_EQ(reader.lineNumber(), 3);
+}
+
+TEST(SceneReader, StopsPastTheSizeLimit) {
+    const std::string text = "aa\nbb\ncc\n";
+    for (const std::uint64_t limit : {6u, 7u, 8u, 9u, 100u}) {
+        SCOPED_TRACE(limit);
+        const std::vector<std::string> want =
+            limit < 9 ? std::vector<std::string>{"aa", "bb"} : std::vector<std::string>{"aa", "bb", "cc"};
+        const ReadEnd end = limit < 9 ? ReadEnd::TooLarge : ReadEnd::EndOfInput;
+        SceneReader fromText(text, {limit, 100});
+        EXPECT_EQ(linesOf(fromText), want);
+        EXPECT_EQ(fromText.end(), end);
+        std::istringstream in(text);
+        SceneReader fromStream(in, {limit, 100});
+        EXPECT_EQ(linesOf(fromStream), want);
+        EXPECT_EQ(fromStream.end(), end);
+    }
+    // An endless pipe of lines ends at the limit.
+    Endless newlines('\n');
+    std::istream in(&newlines);
+    SceneReader endless(in, {100'000, 100});
+    EXPECT_EQ(linesOf(endless).size(), 100'000u);
+    EXPECT_EQ(endless.end(), ReadEnd::TooLarge);
+}
+
+TEST(SceneReader, SkipsAByteOrderMarkAtTheStart) {
+    SceneReader text("\xef\xbb\xbfview\n\xef\xbb\xbfx\n", kSmall);
+    EXPECT_EQ(linesOf(text), (std::vector<std::string>{"view", "\xef\xbb\xbfx"}));
+    std::istringstream in("\xef\xbb\xbf");
+    SceneReader onlyTheMark(in, kSmall);
+    EXPECT_TRUE(linesOf(onlyTheMark).empty());
+}
+
+TEST(SceneReader, CountsWordsThatChunksCut) {
+    // "sphere" across the first 64 KiB boundary of the stream.
+    const std::string text = std::string(65533, '#') + "sphere\nsphere spheresphere\nmaterial";
+    const std::vector<std::string_view> words{"sphere", "material", "none"};
+    const std::vector<std::size_t> want{4, 1, 0};
+    EXPECT_EQ(snell::countOccurrences(text, words), want);
+    std::istringstream in(text);
+    EXPECT_EQ(snell::countOccurrences(in, words), want);
+    // A stream's count ends at a NUL byte, as reading does.
+    std::istringstream withNul("sphere\0sphere"s);
+    EXPECT_EQ(snell::countOccurrences(withNul, words), (std::vector<std::size_t>{1, 0, 0}));
+}
+
+TEST(ParserInput, ByteOrderMarkAccepted) {
+    const Scene s = parse("\xef\xbb\xbfview 10 1\nsphere\n");
+    EXPECT_EQ(s.spheres.size(), 1u);
+    // Columns count from after it, as an editor shows them.
+    expectError("\xef\xbb\xbfview 10 x\n", 1, 9, {"'x'"});
+    // Elsewhere it is no mark but bytes of a word.
+    expectError(kView + "\xef\xbb\xbfsphere\n", 2, 1, {"unknown command"});
+}
+
+TEST(ParserInput, StreamParsesAsText) {
+    std::string text = kView;
+    for (int i = 0; i < 5000; ++i) text += "group\nmove " + std::to_string(i) + " 0 -5\nsphere\ngroupend\n";
+    text += "move 1 x 2\nbogus\n";
+    std::istringstream in(text);
+    const snell::ParseOutcome streamed = snell::parseSceneStreamRecovering(in, "t.scn");
+    const snell::ParseOutcome whole = snell::parseSceneRecovering(text, "t.scn");
+    ASSERT_TRUE(streamed.error && whole.error);
+    EXPECT_STREQ(streamed.error->what(), whole.error->what());
+    EXPECT_EQ(streamed.scene.spheres.size(), 5000u);
+    EXPECT_EQ(whole.scene.spheres.size(), 5000u);
+}
+
+TEST(ParserInput, LineLongerThanTheLimitStopsReading) {
+    const std::size_t limit = snell::ParseLimits::kMaxLineBytes;
+    // Spaces: the line would parse, but no scene has such a line.
+    const std::string text = kView + "move 1 2 3" + std::string(limit, ' ') + "\nbogus\n";
+    expectError(text, 2, static_cast<int>(limit) + 1, {"16 MiB"});
+    snell::ParseOutcome outcome = snell::parseSceneRecovering(text, "t.scn");
+    ASSERT_TRUE(outcome.error);
+    EXPECT_EQ(outcome.error->diagnostics().size(), 1u);
 }
 
 // ---------------------------------------------------------------- real files

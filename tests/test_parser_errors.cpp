@@ -75,6 +75,15 @@ TEST(ParserErrors, Overflow) {
     expectError(kView + "scale 1 1 " + std::string(400, '9') + "\n", 2, 11, {"overflow"});
 }
 
+TEST(ParserErrors, NumberErrorsNameTheArgument) {
+    expectError(kView + "light 1 1 one 0 0 0\n", 2, 11,
+                {"expected a number for 'b' (argument 3 of 'light r g b x y z'), got 'one'"});
+    expectError(kView + "material 1 1 1 0 abc 0 1\n", 2, 18, {"'sg' (argument 5 of 'material dr dg db sr sg sb p')"});
+    expectError(kView + "rotate 30 0 0 nan\n", 2, 15, {"'z' (argument 4 of 'rotate angle x y z')", "finite"});
+    expectError("view 10 0x1\n", 1, 9, {"'d' (argument 2 of 'view n d')", "hexadecimal"});
+    expectError(kView + "scale 1 1e999 1\n", 2, 9, {"'sy' (argument 2 of 'scale sx sy sz')", "overflows"});
+}
+
 TEST(ParserErrors, HexFloat) {
     expectError(kView + "move 0x1p3 0 0\n", 2, 6, {"hexadecimal"});
     expectError(kView + "move 0 -0X10 0\n", 2, 8, {"hexadecimal"});
@@ -290,7 +299,7 @@ TEST(ParserAllErrors, EveryErrorInFileOrderWithItsPosition) {
     EXPECT_EQ(e.diagnostic().location.line, 2);
     const std::vector<std::string> lines = linesOf(e.what());
     ASSERT_EQ(lines.size(), 5u) << e.what();
-    EXPECT_EQ(lines[0], "t.scn:2:8: error: expected a number, got 'x'");
+    EXPECT_EQ(lines[0], "t.scn:2:8: error: expected a number for 'y' (argument 2 of 'move x y z'), got 'x'");
     EXPECT_EQ(lines[1].rfind("t.scn:4:7: error: scale factor must not be zero", 0), 0u) << lines[1];
     EXPECT_EQ(lines[2].rfind("t.scn:5:3: error: unknown command 'bogus'", 0), 0u) << lines[2];
     EXPECT_EQ(lines[3].rfind("t.scn:6:19: error: too many arguments to 'light'", 0), 0u) << lines[3];
@@ -308,8 +317,44 @@ TEST(ParserAllErrors, OneErrorALineTheFirstOnIt) {
     // The rest of a line is skipped after its first error.
     EXPECT_EQ(positionsOf(kView + "scale 0 x 1 extra\nmove 1 2 y\n"), (std::vector<std::string>{"2:7", "3:10"}));
     // Byte-level errors too, wherever they stand.
-    EXPECT_EQ(positionsOf(kView + "move \xff x 0\nsphere # \0\nsphere\r\r\nscale 0 1 1\n"s),
+    EXPECT_EQ(positionsOf(kView + "move \xff x 0\nsphere # \xfe\nsphere\r\r\nscale 0 1 1\n"s),
               (std::vector<std::string>{"2:6", "3:10", "4:7", "5:7"}));
+}
+
+TEST(ParserAllErrors, NulByteStopsReading) {
+    // No text file holds one (/dev/zero, a binary file): the lines before it
+    // are parsed, and nothing after it is read.
+    EXPECT_EQ(positionsOf(kView + "move 1 x 2\nsphere # \0 then\nbogus\n"s),
+              (std::vector<std::string>{"2:8", "3:10"}));
+    // It is its line's error, wherever it stands; a 'view' may have followed.
+    const ParseError e = errorsOf("sphere\r \0\nview 10 1\n"s);
+    EXPECT_EQ(positionsOf(e), std::vector<std::string>{"1:9"});
+    EXPECT_NE(std::string(e.what()).find("NUL byte"), std::string::npos) << e.what();
+}
+
+TEST(ParserAllErrors, WarningsInterleavedByLine) {
+    // Errors at 1:8 and 3:7, and a missing view found at the end of the input.
+    const ParseError errors = errorsOf("move 1 x 2\nsphere\nscale 0 1 1\n");
+    auto at = [](int line, int column, const std::string& message) {
+        snell::Diagnostic d;
+        d.location = {"t.scn", line, column};
+        d.message = message;
+        return d;
+    };
+    const ParseError both = errors.withWarnings(
+        {at(1, 1, "w1"), at(3, 7, "w3 at the error"), at(3, 9, "w3 after it"), at(9, 1, "w9"), at(0, 0, "whole")});
+    const std::vector<std::string> want{
+        "t.scn:1:1: warning: w1",           "t.scn:1:8: error: expected a number",
+        "t.scn:3:7: error: scale factor",   "t.scn:3:7: warning: w3 at the error",
+        "t.scn:3:9: warning: w3 after it",  "t.scn:9:1: warning: w9",
+        "t.scn:1:1: error: missing 'view'", "t.scn: warning: whole",
+    };
+    const std::vector<std::string> lines = linesOf(both.what());
+    ASSERT_EQ(lines.size(), want.size()) << both.what();
+    for (std::size_t k = 0; k < want.size(); ++k) EXPECT_EQ(lines[k].rfind(want[k], 0), 0u) << lines[k];
+    EXPECT_EQ(both.diagnostics().size(), 3u);
+    EXPECT_EQ(both.warnings().size(), 5u);
+    EXPECT_TRUE(errors.warnings().empty());
 }
 
 TEST(ParserAllErrors, ListsTwentyThenCountsTheRest) {

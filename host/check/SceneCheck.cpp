@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <map>
 #include <optional>
 #include <sstream>
@@ -70,7 +71,8 @@ bool behindCamera(const Sphere& s, const Camera& camera) {
     return true;
 }
 
-void warnAboutSpheres(const Scene& scene, const std::string& path, std::vector<Diagnostic>& out) {
+// Returns how many spheres are behind the camera.
+std::size_t warnAboutSpheres(const Scene& scene, const std::string& path, std::vector<Diagnostic>& out) {
     // Lights inside spheres: every pair, unless that is too much work for a warning.
     constexpr double kMaxPairs = 5e7;
     const bool pairs = double(scene.spheres.size()) * double(scene.lights.size()) <= kMaxPairs;
@@ -95,11 +97,56 @@ void warnAboutSpheres(const Scene& scene, const std::string& path, std::vector<D
     }
     list.summarize("light", "lights inside spheres");
     list.summarize("behind", "spheres behind the camera");
+    return behind;
+}
+
+void warnAboutEmptyView(const Scene& scene, const std::string& path, std::size_t behind,
+                        std::vector<Diagnostic>& out) {
     if (behind == scene.spheres.size())
         out.push_back(aboutFile(path, std::string(scene.spheres.empty() ? "the scene has no sphere"
                                                                          : "every sphere is behind the camera") +
                                           ": the image will be the background colour; spheres in front of the "
                                           "camera have z < 1 (the eye is at (0, 0, 1), looking down -z)"));
+}
+
+// SPEC §4: a renderer warns of a material with ks + kt > 1 and says that its
+// float output where light diverges is a partial sum. Once a material, at its
+// first sphere.
+void warnAboutAmplifyingMaterials(const Scene& scene, const std::string& path, std::vector<Diagnostic>& out) {
+    std::vector<bool> seen(scene.materials.size(), false);
+    WarningList list(out);
+    for (const Sphere& s : scene.spheres) {
+        const Material& m = scene.materials[s.material];
+        if (seen[s.material] || !m.amplifies()) continue;
+        seen[s.material] = true;
+        char text[400];
+        std::snprintf(text, sizeof text,
+                      "the material of this sphere has ks + kt = %g in a channel, above 1: light can grow from "
+                      "bounce to bounce, and where a pixel's sum diverges its 8-bit value is 255 and a float "
+                      "image (.pfm, .exr) holds a partial sum; keep ks + kt <= 1 in every channel for light that fades",
+                      m.largestGain());
+        list.add({path, s.location.line, s.location.column}, text, "amplifying");
+    }
+    list.summarize("amplifying", "spheres of other amplifying materials");
+}
+
+// The warnings at lines of the file: the parser's, and those of its spheres.
+// Returns how many spheres are behind the camera.
+std::size_t warnAboutLines(const Scene& scene, const std::string& path, std::vector<Diagnostic>& out) {
+    out.insert(out.end(), scene.warnings.begin(), scene.warnings.end());
+    const std::size_t behind = warnAboutSpheres(scene, path, out);
+    warnAboutAmplifyingMaterials(scene, path, out);
+    return behind;
+}
+
+// Line by line as a compiler reports; those about the whole file after them.
+std::vector<Diagnostic> inLineOrder(std::vector<Diagnostic> warnings) {
+    auto key = [](const Diagnostic& d) {
+        return std::pair(d.location.line > 0 ? d.location.line : std::numeric_limits<int>::max(), d.location.column);
+    };
+    std::stable_sort(warnings.begin(), warnings.end(),
+                     [&key](const Diagnostic& a, const Diagnostic& b) { return key(a) < key(b); });
+    return warnings;
 }
 
 // No light and no ambient: the spheres' own terms are black, and they can
@@ -231,14 +278,27 @@ bool warnAboutAmplifying(const Scene& scene, const RenderShape& shape, const std
 }  // namespace
 
 std::vector<Diagnostic> sceneWarnings(const Scene& scene, const std::string& path, RenderShape shape) {
-    std::vector<Diagnostic> out = scene.warnings;
-    warnAboutSpheres(scene, path, out);
+    std::vector<Diagnostic> out;
+    const std::size_t behind = warnAboutLines(scene, path, out);
+    warnAboutEmptyView(scene, path, behind, out);
     warnAboutDarkness(scene, path, out);
     // The amplifying warning names the cheaper tree; the size's, a cheaper
     // preview. Where both apply, the tree is the cause.
     SampleReference reference(scene);
     if (!warnAboutAmplifying(scene, shape, path, reference, out)) warnAboutCost(scene, shape, path, reference, out);
-    return out;
+    return inLineOrder(std::move(out));
+}
+
+std::vector<Diagnostic> partialSceneWarnings(const Scene& scene, const std::string& path) {
+    std::vector<Diagnostic> out;
+    warnAboutLines(scene, path, out);
+    return inLineOrder(std::move(out));
+}
+
+Scene sceneOrErrors(ParseOutcome outcome, const std::string& path, bool withWarnings) {
+    if (!outcome.error) return std::move(outcome.scene);
+    if (!withWarnings) throw std::move(*outcome.error);
+    throw outcome.error->withWarnings(partialSceneWarnings(outcome.scene, path));
 }
 
 SceneReport checkScene(const Scene& scene, const std::string& path) {
@@ -286,11 +346,27 @@ std::string SceneReport::json(const Scene& scene) const {
       << ", \"lights\": " << lights << ", \"materials\": " << materials << ", \"reflective_spheres\": " << reflective
       << ", \"refractive_spheres\": " << refractive << ", \"amplifying\": " << (amplifying ? "true" : "false")
       << ", \"bounds\": {\"lower\": [" << lower.x << ", " << lower.y << ", " << lower.z << "], \"upper\": ["
-      << upper.x << ", " << upper.y << ", " << upper.z << "]}, \"warnings\": [";
-    for (std::size_t i = 0; i < warnings.size(); ++i)
-        s << (i ? ", " : "") << jsonString(warnings[i].format("warning"));
-    s << "]}";
+      << upper.x << ", " << upper.y << ", " << upper.z << "]}, \"errors\": [], \"errors_not_shown\": 0, \"warnings\": "
+      << diagnosticsJson(warnings) << "}";
     return s.str();
+}
+
+std::string diagnosticsJson(const std::vector<Diagnostic>& diagnostics) {
+    std::string out = "[";
+    for (const Diagnostic& d : diagnostics) {
+        const bool placed = d.location.line > 0;  // else about the whole file
+        out += (out.size() > 1 ? ", " : "") + std::string("{\"file\": ") + jsonString(d.location.file) +
+               ", \"line\": " + (placed ? std::to_string(d.location.line) : "null") +
+               ", \"column\": " + (placed ? std::to_string(d.location.column) : "null") +
+               ", \"message\": " + jsonString(d.message) + "}";
+    }
+    return out + "]";
+}
+
+std::string errorsJson(const std::string& sceneName, const ParseError& errors) {
+    return "{\"scene\": " + jsonString(sceneName) + ", \"errors\": " + diagnosticsJson(errors.diagnostics()) +
+           ", \"errors_not_shown\": " + std::to_string(errors.notShown()) +
+           ", \"warnings\": " + diagnosticsJson(errors.warnings()) + "}";
 }
 
 }  // namespace snell

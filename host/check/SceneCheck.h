@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "render/RenderRequest.h"
+#include "scene/Parser.h"
 #include "scene/Scene.h"
 
 namespace snell {
@@ -32,14 +33,30 @@ struct RenderShape {
 };
 
 // What looks wrong in a scene, the same for `check` and `render` (one set of
-// warnings, one set of thresholds), each saying what to do: the parser's;
-// lights inside spheres; spheres behind the camera; a scene that can only
+// warnings, one set of thresholds), each saying what to do, in line order
+// (those about the whole file last): the parser's; lights inside spheres;
+// spheres behind the camera; amplifying materials; a scene that can only
 // render the background or black; a render expected to trace many rays
 // (its size, or its amplifying materials at the defaults; rays counted on a
 // few pixels with the CPU reference). `path`: the scene's file, for the warnings' locations.
 std::vector<Diagnostic> sceneWarnings(const Scene& scene, const std::string& path, RenderShape shape);
 
+// The warnings of a scene with errors (ParseOutcome): those about the lines
+// that parsed, in line order; none about the scene as a whole, which it is not.
+std::vector<Diagnostic> partialSceneWarnings(const Scene& scene, const std::string& path);
+
+// The scene of a parse without errors; else throws its ParseError, reported
+// with the partial scene's warnings where `withWarnings`.
+Scene sceneOrErrors(ParseOutcome outcome, const std::string& path, bool withWarnings);
+
 // The report of `snell check`: warnings at the scene's own size.
 SceneReport checkScene(const Scene& scene, const std::string& path);
+
+// Diagnostics as a JSON array of {"file", "line", "column", "message"}; line
+// and column are null for those about the whole file.
+std::string diagnosticsJson(const std::vector<Diagnostic>& diagnostics);
+// `snell check --json` of a scene with errors: its name, errors (the listed
+// ones, and how many more), and the warnings of the errors' report.
+std::string errorsJson(const std::string& sceneName, const ParseError& errors);
 
 }  // namespace snell

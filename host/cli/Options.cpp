@@ -3,8 +3,8 @@
 #include <cmath>
 #include <cstdlib>
 #include <iostream>
-#include <iterator>
 
+#include "check/SceneCheck.h"
 #include "cli/ExitStatus.h"
 #include "gpu/ComputeRenderer.h"
 #include "image/ImageIO.h"
@@ -79,19 +79,16 @@ void addTreeOptions(CLI::App& command, TreeOptions& o, const TreeHelp& help) {
         ->check(CLI::Range(1, ParseLimits::kMaxSupersample));
 }
 
-Scene readScene(const std::string& argument) {
-    if (argument != "-") return parseSceneFile(argument);
-    // Standard input may be a pipe: read it to its end, never seek.
-    const std::string text{std::istreambuf_iterator<char>(std::cin), std::istreambuf_iterator<char>()};
-    if (std::cin.bad()) {
-        Diagnostic d;
-        d.location = {"<stdin>", 0, 0};
-        d.message = "cannot read the scene from standard input";
-        throw ParseError(std::move(d));
-    }
-    Scene scene = parseScene(text, "<stdin>");
-    scene.name = "stdin";
-    return scene;
+ParseOutcome parseSceneArgument(const std::string& argument) {
+    if (argument != "-") return parseSceneFileRecovering(argument);
+    // Standard input may be a pipe, even an endless one: a stream, never seeked.
+    ParseOutcome outcome = parseSceneStreamRecovering(std::cin, "<stdin>");
+    outcome.scene.name = "stdin";
+    return outcome;
+}
+
+Scene readScene(const std::string& argument, bool withWarnings) {
+    return sceneOrErrors(parseSceneArgument(argument), sceneFile(argument), withWarnings);
 }
 
 std::string pipelineCachePath() {

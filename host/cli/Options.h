@@ -8,6 +8,7 @@
 
 #include "gpu/GpuScene.h"
 #include "image/ImageIO.h"
+#include "scene/Parser.h"
 #include "scene/Scene.h"
 #include "vulkan/VulkanContext.h"
 
@@ -56,8 +57,11 @@ struct TreeHelp {
 void addTreeOptions(CLI::App& command, TreeOptions& options, const TreeHelp& help);
 
 // The scene argument: a file, or - for standard input (named <stdin> in
-// messages; its default output is stdin.png). Throws ParseError.
-Scene readScene(const std::string& argument);
+// messages; its default output is stdin.png), read as a stream in bounded
+// memory. parseSceneArgument returns its errors; readScene throws them as a
+// ParseError, with the warnings of the lines that parsed where `withWarnings`.
+ParseOutcome parseSceneArgument(const std::string& argument);
+Scene readScene(const std::string& argument, bool withWarnings = true);
 // The scene argument as messages name it.
 inline std::string sceneFile(const std::string& argument) { return argument == "-" ? "<stdin>" : argument; }
 // Help text of a scene argument.

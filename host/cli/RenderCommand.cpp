@@ -286,7 +286,7 @@ CLI::App* RenderCommand::define(CLI::App& app) {
 int RenderCommand::run() {
     const auto totalStart = Clock::now();
     const auto parseStart = Clock::now();
-    const Scene scene = readScene(o_.scene);
+    const Scene scene = readScene(o_.scene, !o_.quiet);
     const double parseMs = msSince(parseStart);
     RenderRequest request = makeRequest(scene);
     if (!o_.quiet)

@@ -11,10 +11,10 @@
 #include <fstream>
 #include <map>
 #include <optional>
-#include <sstream>
 #include <unordered_map>
 #include <vector>
 
+#include "scene/SceneReader.h"
 #include "scene/SceneWords.h"
 #include "scene/Transform.h"
 
@@ -23,54 +23,47 @@ namespace {
 
 using namespace scenewords;
 
+std::string tooLarge() {
+    return "larger than snell's limit of 2 GiB for a scene (" + std::to_string(ParseLimits::kMaxSceneBytes) + " bytes)";
+}
+
+ReadLimits readLimits() { return {ParseLimits::kMaxSceneBytes, ParseLimits::kMaxLineBytes}; }
+
+const std::vector<std::string_view> kSizeWords{"sphere", "material", "refraction"};
+
 class Parser {
 public:
-    Parser(std::string_view text, std::string fileName) : text_(text), file_(std::move(fileName)) {
+    explicit Parser(std::string fileName) : file_(std::move(fileName)) {
         std::filesystem::path p(file_);
         scene_.name = p.stem().string();
     }
 
-    ParseOutcome run() {
-        reserveForText();
-        const int stoppedAtLine = scanLines();
-        if (stoppedAtLine == 0) checkEndOfFile();
-        // Warnings are about a scene that will be rendered: one without errors.
-        if (errors_.empty()) addWarnings();
+    // Reserve for the spheres and materials the text names at most (counts of
+    // kSizeWords), so a million-sphere file is not copied as the vectors grow.
+    void reserve(const std::vector<std::size_t>& counts) {
+        const std::size_t spheres = std::min(counts[0], ParseLimits::kMaxSpheres);
+        scene_.spheres.reserve(spheres);
+        materialIndex_.reserve(std::min(spheres, counts[1] + counts[2]) + 1);
+    }
+
+    ParseOutcome run(SceneReader& reader) {
+        std::string_view line;
+        int stoppedAtLine = 0;
+        while (reader.next(line)) {
+            parseLineRecovering(line, reader.lineNumber());
+            if (errors_.full()) {
+                stoppedAtLine = reader.lineNumber();
+                break;
+            }
+        }
+        errors_.endOfInput();
+        if (stoppedAtLine == 0) checkEndOfInput(reader);
+        // Of a file read to its end: a group may be closed further on.
+        if (reader.end() == ReadEnd::EndOfInput) addWarnings();
         return {std::move(scene_), errors_.take(stoppedAtLine)};
     }
 
 private:
-    // Reserve for the spheres and materials the text can name at most, so a
-    // million-sphere file is not copied as the vectors grow.
-    void reserveForText() {
-        auto occurrences = [this](std::string_view word) {
-            std::size_t count = 0;
-            for (std::size_t at = text_.find(word); at != std::string_view::npos; at = text_.find(word, at + 1))
-                ++count;
-            return count;
-        };
-        const std::size_t sphereCount = std::min(occurrences("sphere"), ParseLimits::kMaxSpheres);
-        scene_.spheres.reserve(sphereCount);
-        materialIndex_.reserve(std::min(sphereCount, occurrences("material") + occurrences("refraction")) + 1);
-    }
-
-    // Every line, in order. Returns 0, or the line after which reading stopped
-    // because kMaxCountedErrors were found.
-    int scanLines() {
-        std::size_t pos = 0;
-        for (int lineNumber = 1; pos < text_.size(); ++lineNumber) {
-            std::size_t end = pos;
-            while (end < text_.size() && text_[end] != '\n') ++end;
-            std::string_view line = text_.substr(pos, end - pos);
-            // CRLF; a CR not followed by LF (even at the end of the file) is an error.
-            if (end < text_.size() && !line.empty() && line.back() == '\r') line.remove_suffix(1);
-            parseLineRecovering(line, lineNumber);
-            if (errors_.full()) return lineNumber;
-            pos = end + 1;
-        }
-        return 0;
-    }
-
     // An error abandons the rest of its line (one error per line, so the
     // errors come in SPEC §7 file order); the next line is parsed as usual.
     void parseLineRecovering(std::string_view line, int lineNumber) {
@@ -100,19 +93,52 @@ private:
         }
     }
 
-    // SPEC §2, §7: a missing view is an error at 1:1, found (and listed) last.
-    void checkEndOfFile() {
-        if (viewLine_ != 0 || viewTried_) return;
-        Diagnostic missing;
-        missing.location.file = file_;  // at 1:1
-        missing.message = "missing 'view' command: a scene needs exactly one 'view n d'";
-        errors_.add(std::move(missing));
+    // How reading ended. SPEC §2, §7: a missing view is an error at 1:1,
+    // found (and listed) last; where reading stopped short, the view may
+    // have been further on. A NUL byte was its line's error.
+    void checkEndOfInput(const SceneReader& reader) {
+        const std::string readLines = "; stopped reading after line " + std::to_string(reader.lineNumber());
+        switch (reader.end()) {
+            case ReadEnd::EndOfInput:
+                if (viewLine_ != 0 || viewTried_) return;
+                errors_.add(at(1, 1, "missing 'view' command: a scene needs exactly one 'view n d'"));
+                return;
+            case ReadEnd::LineTooLong:
+                errors_.add(at(reader.lineNumber(), int(ParseLimits::kMaxLineBytes) + 1,
+                               "line longer than snell's limit of 16 MiB (" +
+                                   std::to_string(ParseLimits::kMaxLineBytes) +
+                                   " bytes): this is not a scene file; stopped reading here"));
+                return;
+            case ReadEnd::TooLarge:
+                errors_.add(at(0, 0, tooLarge() + readLines));
+                return;
+            case ReadEnd::ReadFailed:
+                errors_.add(at(0, 0, "cannot read the input to its end" + readLines));
+                return;
+            case ReadEnd::NotYet:
+            case ReadEnd::NulByte:
+                return;
+        }
     }
 
+    // Line 0: about the input as a whole, without a position.
+    Diagnostic at(int line, int column, std::string message) const {
+        Diagnostic d;
+        d.location = {file_, line, column};
+        d.message = std::move(message);
+        return d;
+    }
+
+    // Each open group, the outermost first; past a few, one more for the rest.
     void addWarnings() {
-        for (const SourceLocation& open : groupStack_locations_)
-            scene_.warnings.push_back({open, "'group' is never closed by a 'groupend'; add one where the group should end (its "
-                                       "transform and material apply to the end of the file)"});
+        constexpr std::size_t kListed = 10;
+        const std::vector<SourceLocation>& open = groupStack_locations_;
+        for (std::size_t k = 0; k < open.size() && k < kListed; ++k)
+            scene_.warnings.push_back({open[k], "'group' is never closed by a 'groupend'; add one where the group should "
+                                                "end (its transform and material apply to the end of the file)"});
+        if (open.size() > kListed)
+            scene_.warnings.push_back({open[kListed], "this 'group' and the " + std::to_string(open.size() - kListed - 1) +
+                                                          " opened after it are never closed either"});
     }
 
     [[noreturn]] void fail(int column, std::string message) const {
@@ -137,12 +163,14 @@ private:
     }
 
     // Bytes first: NUL, stray CR and invalid UTF-8 anywhere on the line
-    // (comments included) are errors, reported at the offending byte.
+    // (comments included) are errors, reported at the offending byte. A NUL
+    // ends the input (SceneReader) and is the error of its line.
     void checkBytes(std::string_view line) const {
+        if (const std::size_t nul = line.find('\0'); nul != std::string_view::npos)
+            fail(static_cast<int>(nul) + 1, "NUL byte: a scene file is text, and this is not; stopped reading here");
         for (std::size_t i = 0; i < line.size();) {
             const char c = line[i];
             const int column = static_cast<int>(i) + 1;
-            if (c == '\0') fail(column, "NUL byte in scene file");
             if (c == '\r') fail(column, "carriage return not followed by a line feed");
             const std::size_t n = utf8SequenceLength(line, i);
             if (n == 0) fail(column, "invalid UTF-8 byte sequence");
@@ -245,10 +273,11 @@ private:
         if (i < s.size() && std::isalpha(static_cast<unsigned char>(s[i]))) {
             const std::string rest = lower(s.substr(i));
             if (rest == "nan" || rest == "inf" || rest == "infinity" || rest.rfind("nan(", 0) == 0)
-                fail(t, quoted(s) + " is not allowed: numbers must be finite");
+                fail(t, quoted(s) + " is not allowed for " + argumentName(*spec_, index) + ": numbers must be finite");
         }
         if (i + 1 < s.size() && s[i] == '0' && (s[i + 1] == 'x' || s[i + 1] == 'X'))
-            fail(t, "hexadecimal number " + quoted(s) + " is not allowed: use decimal");
+            fail(t, "hexadecimal number " + quoted(s) + " is not allowed for " + argumentName(*spec_, index) +
+                        ": use decimal");
         std::size_t digits = 0;
         const std::size_t mantissaStart = i;
         while (i < s.size() && std::isdigit(static_cast<unsigned char>(s[i]))) { ++i; ++digits; }
@@ -264,7 +293,7 @@ private:
             while (i < s.size() && std::isdigit(static_cast<unsigned char>(s[i]))) { ++i; ++expDigits; }
             ok = expDigits > 0;
         }
-        if (!ok || i != s.size()) fail(t, "expected a number, got " + quoted(s));
+        if (!ok || i != s.size()) fail(t, "expected a number for " + argumentName(*spec_, index) + ", got " + quoted(s));
         // The syntax is checked: convert without allocating (from_chars takes no '+').
         const char* first = s.data() + (s[0] == '+' ? 1 : 0);
         double v = 0.0;
@@ -275,7 +304,7 @@ private:
             v = std::strtod(copy.c_str(), nullptr);
         }
         if (!std::isfinite(v) || end != s.data() + s.size())
-            fail(t, "number " + quoted(s) + " overflows a double");
+            fail(t, "number " + quoted(s) + " for " + argumentName(*spec_, index) + " overflows a double");
         return v;
     }
 
@@ -457,7 +486,6 @@ private:
         Material material;
     };
 
-    std::string_view text_;
     std::string file_;
     int line_ = 1;
     std::vector<Token> tokens_;
@@ -479,16 +507,39 @@ private:
 
 }  // namespace
 
+
 ParseError::ParseError(Diagnostic d) : ParseError(std::vector<Diagnostic>{std::move(d)}, 0, 0) {}
 
-ParseError::ParseError(std::vector<Diagnostic> listed, std::size_t notShown, int stoppedAtLine)
-    : std::runtime_error(errorReport(listed, notShown, stoppedAtLine)),
+ParseError::ParseError(std::vector<Diagnostic> listed, std::size_t notShown, int stoppedAtLine, std::size_t endOfInput)
+    : std::runtime_error(errorReport({listed, notShown, stoppedAtLine, endOfInput, {}})),
       diagnostics_(std::move(listed)),
       notShown_(notShown),
-      stoppedAtLine_(stoppedAtLine) {}
+      stoppedAtLine_(stoppedAtLine),
+      endOfInput_(endOfInput) {}
+
+ParseError::ParseError(const ParseError& errors, std::vector<Diagnostic> warnings)
+    : std::runtime_error(errorReport(
+          {errors.diagnostics_, errors.notShown_, errors.stoppedAtLine_, errors.endOfInput_, warnings})),
+      diagnostics_(errors.diagnostics_),
+      notShown_(errors.notShown_),
+      stoppedAtLine_(errors.stoppedAtLine_),
+      endOfInput_(errors.endOfInput_),
+      warnings_(std::move(warnings)) {}
+
+ParseError ParseError::withWarnings(std::vector<Diagnostic> warnings) const {
+    return ParseError(*this, std::move(warnings));
+}
 
 ParseOutcome parseSceneRecovering(std::string_view text, const std::string& fileName) {
-    return Parser(text, fileName).run();
+    SceneReader reader(text, readLimits());
+    Parser parser(fileName);
+    parser.reserve(countOccurrences(text.substr(0, ParseLimits::kMaxSceneBytes), kSizeWords));
+    return parser.run(reader);
+}
+
+ParseOutcome parseSceneStreamRecovering(std::istream& in, const std::string& fileName) {
+    SceneReader reader(in, readLimits());
+    return Parser(fileName).run(reader);
 }
 
 Scene parseScene(std::string_view text, const std::string& fileName) {
@@ -497,35 +548,38 @@ Scene parseScene(std::string_view text, const std::string& fileName) {
     return std::move(outcome.scene);
 }
 
-Scene parseSceneFile(const std::string& path) {
+ParseOutcome parseSceneFileRecovering(const std::string& path) {
     // A file that cannot be read has no position to report: "FILE: error: ...".
     auto fileError = [&path](const std::string& message) {
         Diagnostic d;
-        d.location.file = path;
-        d.location.line = d.location.column = 0;
+        d.location = {path, 0, 0};
         d.message = message;
-        return ParseError(std::move(d));
+        Scene named;
+        named.name = std::filesystem::path(path).stem().string();
+        return ParseOutcome{std::move(named), ParseError(std::move(d))};
     };
     std::error_code ec;
-    if (std::filesystem::is_directory(path, ec)) throw fileError("is a directory, not a scene file");
-    std::ifstream in(path, std::ios::binary | std::ios::ate);
-    if (!in) throw fileError(std::string("cannot open scene file: ") + std::strerror(errno));
-    std::string text;
-    const std::streamoff size = in.tellg();
-    if (size > 0) {
-        text.resize(static_cast<std::size_t>(size));
-        in.seekg(0);
-        in.read(text.data(), size);
-    } else {
-        // Not a regular file (a pipe, say): read until the end.
+    if (std::filesystem::is_directory(path, ec)) return fileError("is a directory, not a scene file");
+    std::ifstream in(path, std::ios::binary);
+    if (!in) return fileError(std::string("cannot open scene file: ") + std::strerror(errno));
+    // A regular file's size is known before reading it.
+    Parser parser(path);
+    if (std::filesystem::is_regular_file(path, ec)) {
+        // Its size is known before reading it, and it can be read twice.
+        if (const auto size = std::filesystem::file_size(path, ec); !ec && size > ParseLimits::kMaxSceneBytes)
+            return fileError("the file's " + std::to_string(size) + " bytes are " + tooLarge());
+        parser.reserve(countOccurrences(in, kSizeWords));
         in.clear();
         in.seekg(0);
-        std::ostringstream buffer;
-        buffer << in.rdbuf();
-        text = buffer.str();
     }
-    if (in.bad()) throw fileError("cannot read scene file");
-    return parseScene(text, path);
+    SceneReader reader(in, readLimits());
+    return parser.run(reader);
+}
+
+Scene parseSceneFile(const std::string& path) {
+    ParseOutcome outcome = parseSceneFileRecovering(path);
+    if (outcome.error) throw std::move(*outcome.error);
+    return std::move(outcome.scene);
 }
 
 }  // namespace snell

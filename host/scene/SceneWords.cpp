@@ -104,19 +104,57 @@ Token commandWord(std::string_view line) {
     return {line.substr(i, j - i), static_cast<int>(i) + 1};
 }
 
-std::string errorReport(const std::vector<Diagnostic>& listed, std::size_t notShown, int stoppedAtLine) {
+namespace {
+
+// Does `warning` come before `error`? By line and column; without a line
+// (about the whole input) after every line.
+bool comesBefore(const Diagnostic& warning, const Diagnostic& error) {
+    const SourceLocation& w = warning.location;
+    const SourceLocation& e = error.location;
+    if (w.line <= 0) return false;
+    if (e.line <= 0) return true;
+    return w.line != e.line ? w.line < e.line : w.column < e.column;
+}
+
+}  // namespace
+
+std::string errorReport(const ErrorReport& r) {
     std::string out;
-    for (const Diagnostic& d : listed) {
+    auto add = [&out](const Diagnostic& d, const char* severity) {
         if (!out.empty()) out += '\n';
-        out += d.format("error");
+        out += d.format(severity);
+    };
+    std::size_t w = 0;
+    auto warningsBefore = [&](const Diagnostic& error) {
+        for (; w < r.warnings.size() && comesBefore(r.warnings[w], error); ++w) add(r.warnings[w], "warning");
+    };
+    Diagnostic afterTheLines;  // the errors found once the lines were read come after them
+    afterTheLines.location.line = 0;
+    for (std::size_t k = 0; k < r.listed.size(); ++k) {
+        warningsBefore(k < r.endOfInput ? r.listed[k] : afterTheLines);
+        add(r.listed[k], "error");
     }
-    if (notShown == 0) return out;
-    out += '\n' + listed.front().location.file + ": error: " + (stoppedAtLine > 0 ? "at least " : "") +
-           std::to_string(notShown) + " more error" + (notShown == 1 ? "" : "s") + " not shown";
-    if (stoppedAtLine > 0)
-        out += " (stopped reading at line " + std::to_string(stoppedAtLine) + " after " +
+    for (; w < r.warnings.size(); ++w) add(r.warnings[w], "warning");
+    if (r.notShown == 0) return out;
+    out += '\n' + r.listed.front().location.file + ": error: " + (r.stoppedAtLine > 0 ? "at least " : "") +
+           std::to_string(r.notShown) + " more error" + (r.notShown == 1 ? "" : "s") + " not shown";
+    if (r.stoppedAtLine > 0)
+        out += " (stopped reading at line " + std::to_string(r.stoppedAtLine) + " after " +
                std::to_string(ParseLimits::kMaxCountedErrors) + " errors)";
     return out;
+}
+
+std::string argumentName(const CommandSpec& spec, int index) {
+    // The usage names the arguments: "move x y z".
+    std::string_view rest = spec.usage;
+    for (int k = 0; k <= index && !rest.empty(); ++k) {
+        const std::size_t space = rest.find(' ');
+        if (k == index)
+            return "'" + std::string(rest.substr(0, space)) + "' (argument " + std::to_string(index) + " of '" +
+                   std::string(spec.usage) + "')";
+        rest = space == std::string_view::npos ? std::string_view() : rest.substr(space + 1);
+    }
+    return "argument " + std::to_string(index) + " of '" + std::string(spec.usage) + "'";
 }
 
 }  // namespace snell::scenewords

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -43,15 +44,18 @@ public:
     }
     bool empty() const { return count_ == 0; }
     bool full() const { return count_ >= ParseLimits::kMaxCountedErrors; }
+    // The lines are read: errors added from now on are about the input as a whole.
+    void endOfInput() { endOfInput_ = listed_.size(); }
     std::optional<ParseError> take(int stoppedAtLine) {
         if (count_ == 0) return std::nullopt;
         const std::size_t notShown = count_ - listed_.size();
-        return ParseError(std::move(listed_), notShown, stoppedAtLine);
+        return ParseError(std::move(listed_), notShown, stoppedAtLine, endOfInput_);
     }
 
 private:
     std::vector<Diagnostic> listed_;
     std::size_t count_ = 0;
+    std::size_t endOfInput_ = SIZE_MAX;
 };
 
 // The command of that name, or null.
@@ -67,7 +71,19 @@ std::size_t utf8SequenceLength(std::string_view s, std::size_t i);
 // The first word of a raw line (up to a space, tab or '#'), bad bytes and all:
 // what a line that failed was meant to do.
 Token commandWord(std::string_view line);
-// The errors as printed: each listed one, then how many more were not shown.
-std::string errorReport(const std::vector<Diagnostic>& listed, std::size_t notShown, int stoppedAtLine);
+// What a ParseError reports.
+struct ErrorReport {
+    const std::vector<Diagnostic>& listed;
+    std::size_t notShown;
+    int stoppedAtLine;
+    std::size_t endOfInput;                 // listed[endOfInput...] were found after the lines
+    const std::vector<Diagnostic>& warnings;  // in line order, those without a line last
+};
+// The errors as printed: each listed one, among the warnings by line, then
+// how many more errors were not shown.
+std::string errorReport(const ErrorReport& report);
+// An argument of `spec` as messages name it, counted from 1:
+// "'y' (argument 2 of 'move x y z')".
+std::string argumentName(const CommandSpec& spec, int index);
 
 }  // namespace snell::scenewords
