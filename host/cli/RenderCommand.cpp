@@ -140,6 +140,7 @@ private:
         return !o_.cpu && !o_.tree.depth && !o_.tree.minWeight && !o_.tolerance && !o_.treeBudget;
     }
     void refuseRunawayTrees(const Scene& scene, const TraceSettings& trace) const;
+    void refuseGpuOptions() const;
     RenderOutcome renderOnCpu(const Scene& scene, RenderRequest& request, OutputStream& stream,
                               Progress& progress) const;
     RenderOutcome renderOnGpu(const Scene& scene, RenderRequest& request, OutputStream& stream,
@@ -160,12 +161,15 @@ CLI::App* RenderCommand::define(CLI::App& app) {
     CLI::App* c = app.add_subcommand("render", "Render a scene file to an image (PNG, PPM, PFM or EXR by extension)");
     c->add_option("scene", o_.scene, kSceneHelp)->required();
     c->add_option("-o,--output", o_.output,
-                  "Output image: .png, .ppm (P6), .pfm or .exr (float); - for PPM on standard output; default "
-                  "SCENE.png")
+                  "Output image: .png, .ppm (P6), .pfm or .exr (float); - for PPM (the only format there) on "
+                  "standard output, refused where that is a terminal; default SCENE.png")
         ->check(kImageFormat);
-    c->add_flag("--cpu", o_.cpu, "Render with the double-precision CPU reference instead of the GPU");
+    c->add_flag("--cpu", o_.cpu,
+                "Render with the double-precision CPU reference instead of the GPU; the GPU's own options (--gpu, "
+                "--precision, --traversal, --validation, --count-lanes) are refused with it, their environment "
+                "variables ignored");
     c->add_option("-s,--size", o_.size, "Image size in pixels (overrides the scene's view n)")
-        ->check(CLI::Range(1, ParseLimits::kMaxImageSize));
+        ->check(wholeNumber(1, ParseLimits::kMaxImageSize));
     addTreeOptions(*c, o_.tree,
                    {"Maximum reflection/refraction depth; without --tolerance, a fixed tree of this depth traced "
                     "once (default: 10000, a safety cap: the tolerance decides)",
@@ -176,10 +180,10 @@ CLI::App* RenderCommand::define(CLI::App& app) {
                   "Trace each pixel until what its cut-offs may have lost is at most T (where no bound exists: until "
                   "its estimated error is); 0: a fixed tree (default: GPU 0.5/255 = 0.00196, exact in 8 bits; "
                   "CPU 0.01/255; 0 when --depth or --min-weight is given alone)")
-        ->check(kFinite)->check(CLI::Range(0.0, 1.0));
+        ->check(number(0.0, 1.0));
     c->add_option("--tree-budget", o_.treeBudget,
                   "Stop a pixel's ray trees after N rays a sample and report the pixel; 0: no limit (default: 65536)")
-        ->check(CLI::NonNegativeNumber);
+        ->check(wholeNumber(0));
     c->add_flag("--allow-runaway", o_.allowRunaway,
                 "Trace even when the settings allow a ray tree of astronomical size (no tree budget, and "
                 "amplifying materials or no cut-off): the render may never end");
@@ -191,7 +195,7 @@ CLI::App* RenderCommand::define(CLI::App& app) {
     c->add_option("--region", o_.region,
                   "Render only pixels X0..X1-1, Y0..Y1-1 of the image, as an image of that window (for a "
                   "render farm: join the pieces with 'snell assemble')")
-        ->expected(4)->check(CLI::NonNegativeNumber);
+        ->expected(4)->check(wholeNumber(0, std::numeric_limits<int>::max()));
     addDeviceOptions(*c, o_.device);
     c->add_flag("--stats", o_.stats,
                 "Print timings and ray counts as one JSON object on the last line of stdout (stderr with -o -)");
@@ -205,6 +209,8 @@ CLI::App* RenderCommand::define(CLI::App& app) {
 
 int RenderCommand::run() {
     const auto totalStart = Clock::now();
+    if (o_.cpu) refuseGpuOptions();
+    else o_.device.readEnvironment();
     const auto parseStart = Clock::now();
     const Scene scene = readScene(o_.scene);
     const double parseMs = msSince(parseStart);
@@ -243,6 +249,22 @@ int RenderCommand::run() {
             << std::endl;
     }
     return kExitSuccess;
+}
+
+// The options that choose how the GPU renders do nothing for the CPU
+// reference: given with --cpu they are a mistake, refused rather than
+// ignored. Their environment variables are standing preferences, not
+// refused (and not read).
+void RenderCommand::refuseGpuOptions() const {
+    std::vector<std::string> given = o_.device.given();
+    if (o_.countLanes) given.push_back("--count-lanes");
+    if (given.empty()) return;
+    std::string names;
+    for (std::size_t i = 0; i < given.size(); ++i)
+        names += (i == 0 ? "" : i + 1 == given.size() ? " and " : ", ") + given[i];
+    throw InputError(names + (given.size() > 1 ? " apply" : " applies") +
+                     " to GPU renders only, and --cpu renders with the CPU reference (double precision, on the "
+                     "host's cores): drop " + (given.size() > 1 ? "them" : "it") + " or --cpu");
 }
 
 TraceSettings RenderCommand::traceSettings() const {
