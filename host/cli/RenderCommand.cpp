@@ -220,8 +220,10 @@ int RenderCommand::run() {
                                                   {request.width, request.supersample, defaultTree(), request.trace, request.window}))
             std::cerr << w.format("warning") << "\n";
 
+    // Every file written is checked before any work, so none fails after the render.
     const std::string output = o_.output.empty() ? scene.name + ".png" : o_.output;
     checkWritable(output);
+    if (!o_.boundImage.empty()) checkWritable(o_.boundImage);
     request.truncation = &truncation_;
     std::vector<float> bound;
     if (!o_.boundImage.empty()) request.boundImage = &bound;
@@ -442,7 +444,7 @@ std::string RenderCommand::statsJson(const Scene& scene, const RenderRequest& re
       << ", \"kernel\": \"" << r.kernel << "\", \"kernel_object\": \"" << r.kernelObject << "\""
       << ", \"width\": " << request.width << ", \"height\": " << request.height
       << ", \"supersample\": " << request.supersample << ", \"max_depth\": " << request.trace.maxDepth
-      << ", \"min_weight\": " << request.trace.minWeight << ", \"spheres\": " << scene.spheres.size()
+      << ", \"min_weight\": " << exactNumber(request.trace.minWeight) << ", \"spheres\": " << scene.spheres.size()
       << ", \"true_spheres\": " << scene.spheres.size() - scene.ellipsoidCount()
       << ", \"ellipsoids\": " << scene.ellipsoidCount() << ", \"lights\": " << scene.lights.size()
       << ", \"parse_ms\": " << parseMs << ", \"upload_ms\": " << r.uploadMs << ", \"pipeline_ms\": " << r.pipelineMs
@@ -454,7 +456,8 @@ std::string RenderCommand::statsJson(const Scene& scene, const RenderRequest& re
       << ", \"rays\": {\"primary\": " << r.rays.primary << ", \"shadow\": " << r.rays.shadow
       << ", \"reflected\": " << r.rays.reflected << ", \"refracted\": " << r.rays.refracted
       << ", \"total\": " << r.rays.total() << "}"
-      << ", \"tolerance\": " << request.trace.tolerance << ", \"truncation\": " << truncationJson(truncation_);
+      << ", \"tolerance\": " << exactNumber(request.trace.tolerance)
+      << ", \"truncation\": " << truncationJson(truncation_);
     if (o_.countLanes && !o_.cpu)
         j << ", \"lanes\": {\"trace_slots\": " << r.lanes.traceSlots << ", \"trace_busy\": " << r.lanes.traceBusy
           << ", \"trace_occupancy\": " << share(r.lanes.traceBusy, r.lanes.traceSlots)
@@ -470,7 +473,7 @@ OutputStream::OutputStream(const std::string& path, const Scene& scene, const Re
     const std::string settings =
         "size " + std::to_string(request.width) + ", supersample " + std::to_string(request.supersample) +
         ", depth " + std::to_string(request.trace.maxDepth) + ", min-weight " +
-        std::to_string(request.trace.minWeight) + ", " + (o.cpu ? "CPU reference" : "GPU " + o.device.precision);
+        exactNumber(request.trace.minWeight) + ", " + (o.cpu ? "CPU reference" : "GPU " + o.device.precision);
     ImageText text{{"Title", scene.name},
                    {"Source", sceneFile(o.scene)},
                    {"Software", std::string("snell ") + SNELL_VERSION},
