@@ -88,14 +88,23 @@ or
 alone ask for one fixed tree instead.
 .PP
 Standard output carries only data: an image written to
-.BR "\-o \-" ,
+.B "\-o \-"
+(binary PPM, the only format there; refused when standard output is a
+terminal: redirect it or pipe it to a converter),
 or the JSON of
 .B \-\-stats
 and
 .BR \-\-json .
 Messages, warnings and the progress bar go to standard error. An image is
 written under a temporary name and renamed once complete, so a failed or
-interrupted command never leaves a partial file or clobbers an old one.
+interrupted command never leaves a partial file or clobbers an old one;
+every file a render writes is checked before it starts.
+.PP
+A mistake on the command line is one line,
+.BI "snell: error: " COMMAND ": " MESSAGE,
+pointing to
+.BI "snell " COMMAND " \-\-help" ;
+status 2.
 .PP
 EOF
   echo ".nf"
@@ -121,7 +130,9 @@ The Vulkan device to use, by its index in the list
 prints; the same as
 .B \-\-gpu
 of render, preview and bench, which wins when both are given. Unset: the
-best device found.
+best device found. Like the two below, it is not read by
+.BR "render \-\-cpu" ,
+which refuses the options themselves.
 .TP
 .B SNELL_TRAVERSAL
 How render and preview search scenes with a BVH, the same as

@@ -70,7 +70,7 @@ SNELL_INJECT_FAULT=cosmic-ray "$SNELL" render "$SCENES/basic.scn" -o "$work/x.pn
 
 # -v says where the time went, on stderr only.
 "$SNELL" render "$SCENES/basic.scn" --size 16 -o "$work/v.png" -v >"$work/out" 2>"$work/err" &&
-  [ ! -s "$work/out" ] && grep -q "render .* ms (gpu-timestamps\|render .* ms (host" "$work/err" && ok || bad "-v: $(cat "$work/err")"
+  [ ! -s "$work/out" ] && grep -q "render .* ms (timed by the \(GPU\|host\)" "$work/err" && ok || bad "-v: $(cat "$work/err")"
 
 # The truncation bound: in --stats, as an image, and --tolerance keeping it
 # within T on both back ends (scenes/mirrors.scn: ks 0.9 corridors).
@@ -123,7 +123,7 @@ if command -v script >/dev/null; then
   # it expects to be short keeps its tiles in blocks (interleaved tiles cost
   # a cheap scene more than its estimate gains).
   script -qfec "$SNELL render $SCENES/basic.scn --size 2048 -v -o $work/prog3.png" "$work/tty" >/dev/null 2>&1
-  grep -q "estimate [0-9]* ms" "$work/tty" && [ -s "$work/prog3.png" ] && ok || bad "no ray estimate for the progress bar"
+  grep -q "time-left probe [0-9.]* ms" "$work/tty" && [ -s "$work/prog3.png" ] && ok || bad "no ray estimate for the progress bar"
   grep -q " 4 tiles, " "$work/tty" && ok || bad "a short render under the bar was not traced in 4 blocks: $(grep -a tiles "$work/tty")"
   # A longer one may go in interleaved tiles (as its probe expects it to
   # take): the image is the one rendered without the bar, whichever it is.

@@ -62,7 +62,7 @@ public:
             ->required();
         c->add_option("-s,--size", size_,
                       "The whole image's size, so a missing piece is an error (default: the extent of the pieces)")
-            ->check(CLI::Range(1, ParseLimits::kMaxImageSize));
+            ->check(wholeNumber(1, ParseLimits::kMaxImageSize));
         addEncodingOptions(*c, encoding_);
         return c;
     }

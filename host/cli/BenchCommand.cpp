@@ -5,6 +5,7 @@
 #include "bench/Bench.h"
 #include "cli/Command.h"
 #include "cli/ExitStatus.h"
+#include "cli/Options.h"
 
 namespace snell::cli {
 namespace {
@@ -19,9 +20,9 @@ public:
         c->add_option("scenes", o_.scenes,
                       "Scene files or directories (default: scenes/, scenes/hard/, the course and bench scenes)");
         c->add_flag("--quick", o_.quick, "A small, fast run (CI): scenes/ and the bench scenes at 32x32, fewer settings");
-        c->add_option("-s,--size", o_.size, "Image size (default 128; quick 32)")->check(CLI::Range(8, 4096));
+        c->add_option("-s,--size", o_.size, "Image size (default 128; quick 32)")->check(wholeNumber(8, 4096));
         c->add_option("--runs", o_.runs, "Timed runs per setting after a warm-up (at least 5)")
-            ->check(CLI::Range(5, 1000));
+            ->check(wholeNumber(5, 1000));
         c->add_option("-o,--out", o_.outDir, "Directory for bench.csv and bench.json (default bench/results)");
         c->add_option("--source-dir", o_.sourceDir,
                       "The snell repository (default: . if it has scenes/, else the build's)");
@@ -29,7 +30,8 @@ public:
                       "Where course-scenes/ and bench-scenes/ are (default SOURCE/../shared)");
         c->add_flag("--no-scaling", noScaling_,
                     "Leave out the render time against sphere count (10 to 10^6 spheres, about a minute)");
-        c->add_option("--gpu", o_.gpu, "Vulkan device index")->envname("SNELL_GPU")->check(CLI::NonNegativeNumber);
+        c->add_option("--gpu", o_.gpu, "Vulkan device index (default: $SNELL_GPU, else the best)")
+            ->check(wholeNumber(0, std::numeric_limits<int>::max()));
         return c;
     }
 
@@ -43,6 +45,7 @@ public:
         o_.snellPath = fs::read_symlink("/proc/self/exe", ec).string();
         o_.cancel = interruptFlag();
         o_.scaling = !noScaling_;
+        if (o_.gpu < 0) o_.gpu = environmentGpu();
         runBench(o_, std::cerr);
         return kExitSuccess;
     }

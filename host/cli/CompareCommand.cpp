@@ -34,18 +34,18 @@ public:
         c->add_option("b", b_, "Reference image")->required();
         c->add_option("--diff", diff_, "Write a false-colour difference image")->check(kImageFormat);
         c->add_option("--bad-threshold", t_.badLevel, "A pixel is bad when a channel differs by more than N/255 (default 3)")
-            ->check(CLI::Range(0, 255));
+            ->check(wholeNumber(0, 255));
         c->add_option("--max-mean", t_.maxMean, "Largest mean absolute error that agrees, in 1/255 (default 0.5)")
-            ->check(kFinite)->check(CLI::NonNegativeNumber);
+            ->check(number(0.0));
         c->add_option("--max-bad", t_.maxBad, "Largest share of bad pixels that agrees, in percent (default 0.1)")
-            ->check(kFinite)->check(CLI::Range(0.0, 100.0));
+            ->check(number(0.0, 100.0));
         c->add_option("--bound-image", bound_,
                       "The reference's bound image (render --bound-image, .pfm or .exr): leave out pixels it does not "
                       "certify, unless the bound proves them wrong")
-            ->check(CLI::ExistingFile);
+            ->check(kExistingFile);
         c->add_option("--max-uncertain", t_.maxUncertain,
                       "Largest share of pixels --bound-image may leave out, in percent; more disagrees (default 1)")
-            ->check(kFinite)->check(CLI::Range(0.0, 100.0));
+            ->check(number(0.0, 100.0));
         c->add_flag("--json", json_, "One JSON object instead of text");
         return c;
     }

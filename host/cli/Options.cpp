@@ -1,8 +1,15 @@
 #include "cli/Options.h"
 
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <iostream>
+
+#include <unistd.h>
 
 #include "check/SceneCheck.h"
 #include "cli/ExitStatus.h"
@@ -12,8 +19,104 @@
 
 namespace snell::cli {
 
+namespace {
+
+// A bound as the messages say it: 16384, 0.5, 1e-05.
+std::string bound(double value) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%g", value);
+    return text;
+}
+
+// Bounds from the width of the value's type (an int's 2147483647) go unsaid.
+bool stated(double bound) { return std::isfinite(bound) && std::abs(bound) < double(std::numeric_limits<int>::max()); }
+
+// "a whole number from 1 to 16384", "a number, 0 or more", "a finite number".
+std::string rangeInWords(const std::string& kind, double lowest, double highest) {
+    const bool low = stated(lowest), high = stated(highest);
+    if (low && high) return kind + " from " + bound(lowest) + " to " + bound(highest);
+    if (low) return kind + ", " + bound(lowest) + " or more";
+    if (high) return kind + ", " + bound(highest) + " or less";
+    return kind == "a number" ? std::string("a finite number") : kind;
+}
+
+// The same, as --help names the option's values: "[1 - 16384]", ">= 0".
+std::string rangeName(double lowest, double highest) {
+    const bool low = stated(lowest), high = stated(highest);
+    if (low && high) return "[" + bound(lowest) + " - " + bound(highest) + "]";
+    if (low) return ">= " + bound(lowest);
+    if (high) return "<= " + bound(highest);
+    return "FINITE";
+}
+
+}  // namespace
+
+CLI::Validator wholeNumber(long long lowest, long long highest) {
+    const double low = double(lowest), high = double(highest);
+    const std::string words = rangeInWords("a whole number", low, high);
+    return CLI::Validator(
+        [=](const std::string& text) {
+            errno = 0;
+            char* end = nullptr;
+            const long long value = std::strtoll(text.c_str(), &end, 10);
+            const bool whole = !text.empty() && !std::isspace(static_cast<unsigned char>(text[0])) && *end == '\0' &&
+                               errno == 0;
+            if (whole && value >= lowest && value <= highest) return std::string();
+            // Past a bound the words leave unsaid (or past any whole number): say it.
+            const std::string limit = !stated(high) && (errno == ERANGE || (whole && value > highest))
+                                          ? " (at most " + std::to_string(highest) + ")"
+                                          : "";
+            return "must be " + words + ", not '" + text + "'" + limit;
+        },
+        rangeName(low, high));
+}
+
+CLI::Validator number(double lowest, double highest) {
+    const std::string words = rangeInWords("a number", lowest, highest);
+    return CLI::Validator(
+        [=](const std::string& text) {
+            char* end = nullptr;
+            const double value = std::strtod(text.c_str(), &end);
+            const bool read = !text.empty() && !std::isspace(static_cast<unsigned char>(text[0])) && *end == '\0';
+            if (read && std::isfinite(value) && value >= lowest && value <= highest) return std::string();
+            return "must be " + words + ", not '" + text + "'";
+        },
+        rangeName(lowest, highest));
+}
+
+const CLI::Validator kFinite = number(-INFINITY, INFINITY);
+
+CLI::Validator oneOf(std::vector<std::string> names) {
+    std::string list, name;
+    for (const std::string& n : names) {
+        list += (list.empty() ? "" : ", ") + n;
+        name += (name.empty() ? "{" : ",") + n;
+    }
+    return CLI::Validator(
+        [names = std::move(names), list](const std::string& text) {
+            if (std::find(names.begin(), names.end(), text) != names.end()) return std::string();
+            return "must be one of " + list + ", not '" + text + "'";
+        },
+        name + "}");
+}
+
+const CLI::Validator kExistingFile(
+    [](const std::string& path) {
+        std::error_code error;
+        const auto status = std::filesystem::status(path, error);
+        if (std::filesystem::is_directory(status)) return "'" + path + "' is a directory, not a file";
+        if (!std::filesystem::exists(status)) return "no such file: '" + path + "'";
+        return std::string();
+    },
+    "FILE");
+
 const CLI::Validator kImageFormat(
     [](const std::string& path) {
+        // gzip's rule: binary data is not for a terminal, where it would
+        // scramble the screen; the render would be wasted too.
+        if (path == kStandardOutput && ::isatty(STDOUT_FILENO))
+            return std::string("- writes a binary PPM image to standard output, which is a terminal here: "
+                               "redirect it to a file (> image.ppm) or pipe it to a program (| display)");
         try {
             formatForPath(path);
             return std::string();
@@ -22,13 +125,6 @@ const CLI::Validator kImageFormat(
         }
     },
     "IMAGE");
-
-const CLI::Validator kFinite(
-    [](const std::string& text) {
-        const double value = std::strtod(text.c_str(), nullptr);
-        return std::isfinite(value) ? std::string() : std::string("must be a finite number");
-    },
-    "FINITE");
 
 namespace {
 std::vector<std::string> exrCompressionNames() {
@@ -42,23 +138,68 @@ void addEncodingOptions(CLI::App& command, EncodingOptions& o) {
     command.add_option("--exr-compression", o.exrCompression,
                        "How an .exr output is compressed, all lossless: piz (default), rle (faster on flat "
                        "images, useless on detailed ones), zip (slower), none (largest)")
-        ->check(CLI::IsMember(exrCompressionNames()));
+        ->check(oneOf(exrCompressionNames()));
 }
 
+namespace {
+const CLI::Validator kPrecisions = oneOf({"fp32", "fp64"});
+const CLI::Validator kTraversals = oneOf({"auto", "bvh", "ray-query"});
+const CLI::Validator kSwitch = oneOf({"1", "0", "true", "false", "yes", "no", "on", "off"});
+}  // namespace
+
 void addDeviceOptions(CLI::App& command, DeviceOptions& o) {
-    command.add_option("--gpu", o.gpu, "Vulkan device index (see 'snell devices'; default: $SNELL_GPU, else the best)")
-        ->envname("SNELL_GPU")->check(CLI::NonNegativeNumber);
-    command.add_option("--precision", o.precision,
-                       "GPU arithmetic for geometry: fp32 (default) or fp64 (needs shaderFloat64; slower; "
-                       "not on NVIDIA's driver)")
-        ->check(CLI::IsMember({"fp32", "fp64"}));
-    command.add_option("--traversal", o.traversal,
-                       "How BVH scenes are searched: bvh (snell's walk), ray-query (the device's ray traversal, "
-                       "VK_KHR_ray_query; fp32), or auto (default: ray queries on GPUs that have them, else bvh)")
-        ->envname("SNELL_TRAVERSAL")->check(CLI::IsMember({"auto", "bvh", "ray-query"}));
-    command.add_flag("--validation", o.validation,
-                     "Enable the Khronos validation layer; any message it reports is an error")
-        ->envname("SNELL_VALIDATION");
+    o.defined = {
+        command.add_option("--gpu", o.gpu,
+                           "Vulkan device index (see 'snell devices'; default: $SNELL_GPU, else the best)")
+            ->check(wholeNumber(0, std::numeric_limits<int>::max())),
+        command.add_option("--precision", o.precision,
+                           "GPU arithmetic for geometry: fp32 (default) or fp64 (needs shaderFloat64; slower; "
+                           "not on NVIDIA's driver)")
+            ->check(kPrecisions),
+        command.add_option("--traversal", o.traversal,
+                           "How BVH scenes are searched: bvh (snell's walk), ray-query (the device's ray traversal, "
+                           "VK_KHR_ray_query; fp32), or auto (ray queries on GPUs that have them, else bvh; the "
+                           "default, unless $SNELL_TRAVERSAL names another)")
+            ->check(kTraversals),
+        command.add_flag("--validation", o.validation,
+                         "Enable the Khronos validation layer (as does SNELL_VALIDATION=1); any message it reports is "
+                         "an error"),
+    };
+}
+
+namespace {
+// A variable's value, or null where it is unset or empty.
+const char* environment(const char* name) {
+    const char* value = std::getenv(name);
+    return value && *value ? value : nullptr;
+}
+
+// The environment's value for an option, checked as the option's own would be.
+std::string checkedEnvironment(const char* name, const CLI::Validator& validator) {
+    std::string value = environment(name);
+    if (const std::string error = validator(value); !error.empty())
+        throw InputError(std::string(name) + ": " + error);
+    return value;
+}
+}  // namespace
+
+int environmentGpu() {
+    if (!environment("SNELL_GPU")) return -1;
+    return std::stoi(checkedEnvironment("SNELL_GPU", wholeNumber(0, std::numeric_limits<int>::max())));
+}
+
+void DeviceOptions::readEnvironment() {
+    auto unset = [this](const char* option) {
+        return std::none_of(defined.begin(), defined.end(),
+                            [&](const CLI::Option* o) { return o->check_name(option) && o->count() > 0; });
+    };
+    if (unset("--gpu")) gpu = environmentGpu();
+    if (unset("--traversal") && environment("SNELL_TRAVERSAL"))
+        traversal = checkedEnvironment("SNELL_TRAVERSAL", kTraversals);
+    if (unset("--validation") && environment("SNELL_VALIDATION")) {
+        const std::string value = checkedEnvironment("SNELL_VALIDATION", kSwitch);
+        validation = value == "1" || value == "true" || value == "yes" || value == "on";
+    }
 }
 
 vk::ContextOptions DeviceOptions::context() const {
@@ -71,12 +212,19 @@ vk::ContextOptions DeviceOptions::context() const {
     return options;
 }
 
+std::vector<std::string> DeviceOptions::given() const {
+    std::vector<std::string> names;
+    for (const CLI::Option* o : defined)
+        if (o->count() > 0) names.push_back(o->get_name());
+    return names;
+}
+
 void addTreeOptions(CLI::App& command, TreeOptions& o, const TreeHelp& help) {
-    command.add_option("-d,--depth", o.depth, help.depth)->check(CLI::Range(0, help.maxDepth));
-    command.add_option("--min-weight", o.minWeight, help.minWeight)->check(kFinite)->check(CLI::Range(0.0, 1.0));
+    command.add_option("-d,--depth", o.depth, help.depth)->check(wholeNumber(0, help.maxDepth));
+    command.add_option("--min-weight", o.minWeight, help.minWeight)->check(number(0.0, 1.0));
     command.add_option("--spp,--supersample", o.supersample,
                        "Rays per pixel per axis (overrides the scene's supersample)")
-        ->check(CLI::Range(1, ParseLimits::kMaxSupersample));
+        ->check(wholeNumber(1, ParseLimits::kMaxSupersample));
 }
 
 ParseOutcome parseSceneArgument(const std::string& argument) {

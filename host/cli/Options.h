@@ -1,8 +1,10 @@
 // Option groups and inputs shared by snell's subcommands, defined once.
 #pragma once
 
+#include <limits>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
@@ -14,10 +16,23 @@
 
 namespace snell::cli {
 
-// The output's format comes from its extension; an unknown one is a command-line error.
+// The output's format comes from its extension; an unknown one is a
+// command-line error, and so is - (a binary image on standard output) where
+// standard output is a terminal.
 extern const CLI::Validator kImageFormat;
-// CLI11's Range lets NaN through (every comparison with it is false).
+
+// Numbers, their range said in words ("must be a whole number from 1 to
+// 16384, not 'abc'", "must be a number, 0 or more"). CLI11's Range writes
+// DBL_MAX in 300 digits, calls a word a value out of range and lets NaN
+// through; these take no NaN or infinity.
+CLI::Validator wholeNumber(long long lowest, long long highest = std::numeric_limits<long long>::max());
+CLI::Validator number(double lowest, double highest = std::numeric_limits<double>::infinity());
+// Any finite number.
 extern const CLI::Validator kFinite;
+// One of `names` ("must be one of fp32, fp64, not 'fp16'").
+CLI::Validator oneOf(std::vector<std::string> names);
+// A file that exists and is not a directory.
+extern const CLI::Validator kExistingFile;
 
 // --exr-compression: how an EXR output is compressed (lossless; see ExrCompression).
 struct EncodingOptions {
@@ -26,12 +41,22 @@ struct EncodingOptions {
 };
 void addEncodingOptions(CLI::App& command, EncodingOptions& options);
 
-// Which Vulkan device renders, and how: --gpu, --precision, --traversal, --validation.
+// Which Vulkan device renders, and how: --gpu, --precision, --traversal,
+// --validation. $SNELL_GPU, $SNELL_TRAVERSAL and $SNELL_VALIDATION stand for
+// the options not given, read by readEnvironment() after parsing (not by
+// CLI11, which mixes them with the command line's): a render with --cpu
+// refuses these options, not a standing preference of the environment.
 struct DeviceOptions {
     int gpu = -1;
     std::string precision = "fp32";
     std::string traversal = "auto";
     bool validation = false;
+    std::vector<const CLI::Option*> defined;  // addDeviceOptions' options
+    // Where the command line left them unset, the environment's values.
+    // Throws InputError, naming the variable, on a malformed value.
+    void readEnvironment();
+    // The options given on the command line, as it names them ("--gpu").
+    std::vector<std::string> given() const;
     gpu::Precision arithmetic() const { return precision == "fp64" ? gpu::Precision::Fp64 : gpu::Precision::Fp32; }
     gpu::Traversal search() const {
         return traversal == "ray-query" ? gpu::Traversal::RayQuery
@@ -42,6 +67,8 @@ struct DeviceOptions {
     vk::ContextOptions context() const;
 };
 void addDeviceOptions(CLI::App& command, DeviceOptions& options);
+// $SNELL_GPU as a device index, -1 where it is unset; InputError where malformed.
+int environmentGpu();
 
 // The ray tree a pixel traces: --depth, --min-weight, --spp. The defaults
 // differ between commands, so each says its own in the help.

@@ -2,6 +2,7 @@
 #include "cli/Command.h"
 #include "cli/ExitStatus.h"
 #include "cli/Options.h"
+#include "image/ImageIO.h"
 #include "preview/Preview.h"
 #include "scene/Parser.h"
 
@@ -15,14 +16,14 @@ public:
         c->footer(kPreviewKeys);
         c->add_option("scene", o_.scene, "Scene file (re-rendered when saved)")->required();
         c->add_option("-s,--size", o_.size, "Rendered image size in pixels (default: the scene's view n)")
-            ->check(CLI::Range(1, 4096));
+            ->check(wholeNumber(1, 4096));
         addTreeOptions(*c, tree_, {"Initial maximum depth (default: 64)",
                                    "Stop rays whose weight falls below W (default: 1e-4)", 256});
         addDeviceOptions(*c, device_);
         c->add_flag("-q,--quiet", o_.quiet, "No warnings or reload timings on stderr");
         CLI::Option* frames =
             c->add_option("--frames", o_.frames, "Scripted: show N frames, then save --screenshot and exit")
-                ->check(CLI::PositiveNumber);
+                ->check(wholeNumber(1, std::numeric_limits<int>::max()));
         c->add_option("--screenshot", o_.screenshot, "Scripted: the PNG to save after --frames frames")->needs(frames);
         c->add_option("--orbit", o_.orbitDegrees, "Scripted: orbit the camera by DEGREES before the first frame")
             ->check(kFinite);
@@ -35,6 +36,9 @@ public:
     int run() override {
         // The window reloads the file when it is saved: standard input cannot be.
         if (o_.scene == "-") throw InputError("preview needs a scene file (it re-reads it when saved), not -");
+        // The screenshot's place is checked before a window opens, not after its frames.
+        if (!o_.screenshot.empty()) checkWritable(o_.screenshot);
+        device_.readEnvironment();
         o_.depth = tree_.depth;
         o_.minWeight = tree_.minWeight;
         o_.supersample = tree_.supersample;

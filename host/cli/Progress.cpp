@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <condition_variable>
 #include <cstdio>
+#include <thread>
 
 #include <unistd.h>
 
@@ -24,8 +26,8 @@ void Progress::show(double fraction, std::uint64_t rays) {
     const double left = secondsLeft(std::chrono::duration<double>(now - renderStart_).count(), fraction, double(rays));
     if (fraction < 1.0 && now - last_ < std::chrono::milliseconds(250)) return;
     last_ = now;
-    shown_ = true;
     const double elapsed = std::chrono::duration<double>(now - start_).count();
+    const double rendering = std::chrono::duration<double>(now - renderStart_).count();
     constexpr int kWidth = 24;
     const int filled = std::clamp(int(fraction * kWidth + 0.5), 0, kWidth);
     std::string line = "\rsnell: [" + std::string(filled, '#') + std::string(kWidth - filled, '.') + "] ";
@@ -33,13 +35,57 @@ void Progress::show(double fraction, std::uint64_t rays) {
     std::snprintf(text, sizeof text, "%5.1f%%  %s elapsed", 100.0 * fraction, formatDuration(elapsed).c_str());
     line += text;
     if (fraction > 0.01 && fraction < 1.0) line += ", ~" + formatDuration(left) + " left";
-    if (rays > 0 && elapsed > 0.0) {
-        std::snprintf(text, sizeof text, ", %.3g Mrays/s", double(rays) / elapsed * 1e-6);
+    if (rays > 0 && rendering > 0.0) {
+        std::snprintf(text, sizeof text, ", %.3g Mrays/s", double(rays) / rendering * 1e-6);
         line += text;
     }
+    draw(line);
+}
+
+void Progress::draw(const std::string& line) {
+    shown_ = true;
     width_ = std::max(width_, line.size());
     std::fprintf(stderr, "%-*s", int(width_), line.c_str());
     std::fflush(stderr);
+}
+
+void Progress::during(const std::string& what, const std::function<void()>& work) {
+    if (!enabled()) return work();
+    constexpr auto kQuiet = std::chrono::milliseconds(250), kTick = std::chrono::milliseconds(100);
+    std::mutex m;
+    std::condition_variable stop;
+    bool finished = false;
+    const auto start = Clock::now();
+    std::thread ticker([&] {
+        std::unique_lock<std::mutex> lock(m);
+        while (!stop.wait_for(lock, kTick, [&] { return finished; })) {
+            const auto now = Clock::now();
+            if (now - start < kQuiet) continue;
+            std::lock_guard<std::mutex> bar(mutex_);
+            if (enabled_)
+                draw("\rsnell: " + what + "... " + formatDuration(std::chrono::duration<double>(now - start).count()));
+        }
+    });
+    auto join = [&] {
+        {
+            std::lock_guard<std::mutex> lock(m);
+            finished = true;
+        }
+        stop.notify_all();
+        ticker.join();
+    };
+    try {
+        work();
+    } catch (...) {
+        join();
+        throw;
+    }
+    join();
+}
+
+void Progress::renderStarts() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    renderStart_ = Clock::now();
 }
 
 void Progress::expectCost(const std::vector<double>& seconds, const std::vector<double>& rays, bool sharesOfTime,

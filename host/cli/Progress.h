@@ -1,6 +1,8 @@
 // A progress bar on standard error, only when it is a terminal: the pixels
 // finished, the time so far, an estimate of the time left and the rays a
-// second, a few times a second; erased when the render ends.
+// second of the render (not of the kernel's compile or the estimate's probe
+// before it), a few times a second; erased when the render ends. Before
+// the render, the same line says what is going on (during()).
 //
 // The time left: a render's cost is uneven over the image (sky above, glass
 // below), and within a region the cheap pixels finish first, so
@@ -40,6 +42,12 @@ public:
     std::function<void(double fraction, std::uint64_t rays)> callback();
     // Erases the bar (before any message that follows the render).
     void done();
+    // Runs `work`, saying "snell: WHAT... 1.2 s" on the bar's line while it
+    // runs, once it has run for a quarter of a second (a kernel taken from
+    // a cache takes milliseconds: nothing flickers).
+    void during(const std::string& what, const std::function<void()>& work);
+    // The render starts now: the rays a second count from here.
+    void renderStarts();
     bool enabled() const { return enabled_; }
     // Each region's expected seconds and rays, in order; the render starts now.
     // `sharesOfTime`: the renderer reports the region in progress by the
@@ -58,6 +66,7 @@ public:
 private:
     using Clock = std::chrono::steady_clock;
     void show(double fraction, std::uint64_t rays);
+    void draw(const std::string& line);  // over the last line drawn; called with mutex_ held
 
     bool enabled_;
     // One way of predicting the regions' cost: expected cost before each

@@ -5,18 +5,18 @@
 #include <cstdio>
 #include <iostream>
 #include <memory>
-#include <numeric>
 #include <optional>
 #include <sstream>
 #include <thread>
-#include <tuple>
 
 #include "common/Clock.h"
 #include "check/SceneCheck.h"
 #include "cli/Command.h"
+#include "cli/CostProbe.h"
 #include "cli/ExitStatus.h"
 #include "cli/Options.h"
 #include "cli/Progress.h"
+#include "cli/RenderReport.h"
 #include "common/Json.h"
 #include "gpu/ComputeRenderer.h"
 #include "image/BackgroundWriter.h"
@@ -98,98 +98,12 @@ std::string truncationJson(const TruncationReport& t) {
     return j.str();
 }
 
-double share(std::uint64_t part, std::uint64_t whole) { return whole ? double(part) / double(whole) : 0.0; }
-
-// What the renderer did, for --verbose and --stats.
-struct RenderOutcome {
-    RayCounts rays;
-    std::string device;
-    std::string traversal = "reference";  // ComputeRenderer::traversal() on the GPU
-    std::string kernel = "reference";     // on the GPU: "folded" (its specialisation folded in) or "driver"
-    std::string kernelObject = "none";    // on the GPU: ComputeRenderer::kernelObject()
-    std::string timing = "host";  // how renderMs was measured
-    double uploadMs = 0, pipelineMs = 0, renderMs = 0, readbackMs = 0;
-    double estimateMs = 0;  // the progress bar's sparse render (estimateCost)
-    int tiles = 0, dispatches = 0;
-    int invocations = 0;  // persistent invocations a dispatch (GPU)
-    bool interleaved = false;  // interleaved tiles, else blocks (GPU)
-    GpuRenderResult::Lanes lanes;
-};
-
-// For the progress bar's time left: the time and the rays each region of
-// the image costs, in the order the renderer finishes them, measured on a
-// render of one pixel in 256 (every 16th row and column of the same image),
-// region by region (a window once, whatever the regions that share it),
-// costing about 1/256 of the render (Progress says which
-// of the two it trusts). From 256² camera rays on: the image's size says
-// little of the render's time (an amplifying scene at 1400² renders longer
-// than a simple one at 8192²), and the probe's 16² or more pixels cost
-// little. `render` returns its milliseconds and rays. With `map`, also each
-// probe pixel's rays (where the renderer counts them): the cost of the
-// 16 × 16 pixels around it, by which the renderer weighs the pixels of the
-// region in progress.
-template <class Render>
-double estimateCost(const Scene& scene, const RenderRequest& request, const std::vector<RenderRegion>& regions,
-                  Progress& progress, RenderOutcome& outcome, Render render, CostMap* map = nullptr) {
-    constexpr int kStride = 16;
-    constexpr double kMinCameraRays = 1 << 16;
-    const PixelWindow area = request.area();
-    const double cameraRays = double(area.width()) * area.height() * request.supersample * request.supersample;
-    if (cameraRays < kMinCameraRays) return 0.0;
-    RenderRequest probe;
-    probe.width = probe.height = std::max(1, request.width / kStride);
-    probe.camera = Camera::fromSpec(probe.width, scene.halfWidth);
-    probe.supersample = request.supersample;
-    probe.trace = request.trace;
-    probe.cancel = request.cancel;
-    const auto start = Clock::now();
-    std::vector<double> seconds, rays;
-    std::vector<float> pixelRays;
-    if (map) *map = CostMap{kStride, probe.width, probe.height, std::vector<float>(std::size_t(probe.width) * probe.height)};
-    std::optional<PixelWindow> last;
-    double windowMs = 0.0, windowRays = 0.0, scale = 0.0;
-    for (const RenderRegion& region : regions) {
-        const PixelWindow& r = region.window;
-        if (last != r) {
-            last = r;
-            const int x0 = std::min(r.x0 / kStride, probe.width - 1), y0 = std::min(r.y0 / kStride, probe.height - 1);
-            probe.window = {x0, y0, std::max(r.x1 / kStride, x0 + 1), std::max(r.y1 / kStride, y0 + 1)};
-            // In the render's own terms: the probe saw one pixel in (its share of) the window's.
-            const PixelWindow seen = probe.area();
-            scale = double(r.width()) * r.height() / (double(seen.width()) * seen.height());
-            probe.rayImage = map ? &pixelRays : nullptr;
-            std::tie(windowMs, windowRays) = render(probe);
-            if (map && pixelRays.size() == std::size_t(seen.width()) * seen.height())
-                for (int y = 0; y < seen.height(); ++y)
-                    std::copy_n(pixelRays.begin() + std::ptrdiff_t(y) * seen.width(), seen.width(),
-                                map->cells.begin() + std::ptrdiff_t(seen.y0 + y) * map->width + seen.x0);
-        }
-        seconds.push_back(1e-3 * windowMs * scale * region.share);
-        rays.push_back(windowRays * scale * region.share);
-    }
-    outcome.estimateMs += msSince(start);
-    if (map && std::all_of(map->cells.begin(), map->cells.end(), [](float c) { return c == 0.0f; })) *map = {};
-    // Regions that share one window are its interleaved tiles: alike.
-    const bool alike = regions.size() > 1 && std::all_of(regions.begin(), regions.end(), [&](const RenderRegion& r) {
-        return r.window == regions[0].window;
-    });
-    progress.expectCost(seconds, rays, map && !map->empty(), alike);
-    return std::accumulate(seconds.begin(), seconds.end(), 0.0);
-}
+// What the bar's line says while the probe renders.
+constexpr const char* kProbing = "rendering 1 pixel in 256 to estimate the time";
 
 // Renders expected to take at least this many seconds are traced in
 // interleaved tiles (RenderRequest::interleavedTiles).
 constexpr double kInterleaveFrom = 2.0;
-
-// The CPU reference finishes rows top to bottom: its regions are bands of rows.
-std::vector<RenderRegion> rowBands(const PixelWindow& area) {
-    constexpr int kBands = 32;
-    std::vector<RenderRegion> bands;
-    const int count = std::min(kBands, area.height());
-    for (int b = 0; b < count; ++b)
-        bands.push_back({{area.x0, area.y0 + area.height() * b / count, area.x1, area.y0 + area.height() * (b + 1) / count}});
-    return bands;
-}
 
 // The image streams to a temporary file beside the output as bands of rows
 // finish, encoded on a thread of its own (BackgroundWriter) while the render
@@ -204,10 +118,12 @@ public:
     void encodeBeside(bool cpuRenderer);
     double encodeMs() const { return writer_->encodeMs(); }    // spent encoding, mostly during the render
     double blockedMs() const { return writer_->blockedMs(); }  // the render's wait for it, and the wait after it
+    bool beside() const { return beside_; }                    // encoded on a thread beside the render
 
 private:
     std::unique_ptr<BackgroundWriter> writer_;
     ImageFormat format_;
+    bool beside_ = false;
     std::string error_;
 };
 
@@ -224,10 +140,15 @@ private:
         return !o_.cpu && !o_.tree.depth && !o_.tree.minWeight && !o_.tolerance && !o_.treeBudget;
     }
     void refuseRunawayTrees(const Scene& scene, const TraceSettings& trace) const;
+    void refuseGpuOptions() const;
     RenderOutcome renderOnCpu(const Scene& scene, RenderRequest& request, OutputStream& stream,
                               Progress& progress) const;
     RenderOutcome renderOnGpu(const Scene& scene, RenderRequest& request, OutputStream& stream,
                               Progress& progress) const;
+    // The progress bar's probe of a GPU render (estimateCost): its expected
+    // cost, and whether its tiles interleave.
+    void estimateGpuCost(const Scene& scene, RenderRequest& request, ComputeRenderer& renderer, Progress& progress,
+                         RenderOutcome& r, CostMap& expectedCost) const;
     void writeBoundImage(const RenderRequest& request, const std::vector<float>& bound) const;
     std::string statsJson(const Scene& scene, const RenderRequest& request, const RenderOutcome& r,
                           const std::string& output, double parseMs, const OutputStream& stream, double totalMs) const;
@@ -240,12 +161,15 @@ CLI::App* RenderCommand::define(CLI::App& app) {
     CLI::App* c = app.add_subcommand("render", "Render a scene file to an image (PNG, PPM, PFM or EXR by extension)");
     c->add_option("scene", o_.scene, kSceneHelp)->required();
     c->add_option("-o,--output", o_.output,
-                  "Output image: .png, .ppm (P6), .pfm or .exr (float); - for PPM on standard output; default "
-                  "SCENE.png")
+                  "Output image: .png, .ppm (P6), .pfm or .exr (float); - for PPM (the only format there) on "
+                  "standard output, refused where that is a terminal; default SCENE.png")
         ->check(kImageFormat);
-    c->add_flag("--cpu", o_.cpu, "Render with the double-precision CPU reference instead of the GPU");
+    c->add_flag("--cpu", o_.cpu,
+                "Render with the double-precision CPU reference instead of the GPU; the GPU's own options (--gpu, "
+                "--precision, --traversal, --validation, --count-lanes) are refused with it, their environment "
+                "variables ignored");
     c->add_option("-s,--size", o_.size, "Image size in pixels (overrides the scene's view n)")
-        ->check(CLI::Range(1, ParseLimits::kMaxImageSize));
+        ->check(wholeNumber(1, ParseLimits::kMaxImageSize));
     addTreeOptions(*c, o_.tree,
                    {"Maximum reflection/refraction depth; without --tolerance, a fixed tree of this depth traced "
                     "once (default: 10000, a safety cap: the tolerance decides)",
@@ -256,10 +180,10 @@ CLI::App* RenderCommand::define(CLI::App& app) {
                   "Trace each pixel until what its cut-offs may have lost is at most T (where no bound exists: until "
                   "its estimated error is); 0: a fixed tree (default: GPU 0.5/255 = 0.00196, exact in 8 bits; "
                   "CPU 0.01/255; 0 when --depth or --min-weight is given alone)")
-        ->check(kFinite)->check(CLI::Range(0.0, 1.0));
+        ->check(number(0.0, 1.0));
     c->add_option("--tree-budget", o_.treeBudget,
                   "Stop a pixel's ray trees after N rays a sample and report the pixel; 0: no limit (default: 65536)")
-        ->check(CLI::NonNegativeNumber);
+        ->check(wholeNumber(0));
     c->add_flag("--allow-runaway", o_.allowRunaway,
                 "Trace even when the settings allow a ray tree of astronomical size (no tree budget, and "
                 "amplifying materials or no cut-off): the render may never end");
@@ -271,7 +195,7 @@ CLI::App* RenderCommand::define(CLI::App& app) {
     c->add_option("--region", o_.region,
                   "Render only pixels X0..X1-1, Y0..Y1-1 of the image, as an image of that window (for a "
                   "render farm: join the pieces with 'snell assemble')")
-        ->expected(4)->check(CLI::NonNegativeNumber);
+        ->expected(4)->check(wholeNumber(0, std::numeric_limits<int>::max()));
     addDeviceOptions(*c, o_.device);
     c->add_flag("--stats", o_.stats,
                 "Print timings and ray counts as one JSON object on the last line of stdout (stderr with -o -)");
@@ -285,6 +209,8 @@ CLI::App* RenderCommand::define(CLI::App& app) {
 
 int RenderCommand::run() {
     const auto totalStart = Clock::now();
+    if (o_.cpu) refuseGpuOptions();
+    else o_.device.readEnvironment();
     const auto parseStart = Clock::now();
     const Scene scene = readScene(o_.scene, !o_.quiet);
     const double parseMs = msSince(parseStart);
@@ -294,8 +220,10 @@ int RenderCommand::run() {
                                                   {request.width, request.supersample, defaultTree(), request.trace, request.window}))
             std::cerr << w.format("warning") << "\n";
 
+    // Every file written is checked before any work, so none fails after the render.
     const std::string output = o_.output.empty() ? scene.name + ".png" : o_.output;
     checkWritable(output);
+    if (!o_.boundImage.empty()) checkWritable(o_.boundImage);
     request.truncation = &truncation_;
     std::vector<float> bound;
     if (!o_.boundImage.empty()) request.boundImage = &bound;
@@ -314,23 +242,8 @@ int RenderCommand::run() {
 
     if (!o_.quiet) printTruncationWarnings(truncation_, request.trace);
     if (o_.verbose)
-        std::fprintf(stderr,
-                     "snell: %s: %dx%d, %s (%s) on %s\n"
-                     "snell: parse %.1f ms, upload %.1f ms, pipeline %.1f ms, render %.1f ms (%s, %d %stiles, %d "
-                     "dispatches), readback %.1f ms, write %.1f ms (%.1f ms of it not overlapped)%s; %.1f ms in all\n",
-                     output.c_str(), request.width, request.height,
-                     o_.cpu ? "CPU reference" : o_.device.precision.c_str(), outcome.traversal.c_str(),
-                     outcome.device.c_str(), parseMs,
-                     outcome.uploadMs, outcome.pipelineMs, outcome.renderMs, outcome.timing.c_str(), outcome.tiles,
-                     outcome.interleaved ? "interleaved " : "", outcome.dispatches, outcome.readbackMs, stream.encodeMs(), stream.blockedMs(),
-                     outcome.estimateMs > 0 ? (", estimate " + std::to_string(int(outcome.estimateMs)) + " ms").c_str() : "",
-                     msSince(totalStart));
-    if (o_.verbose && o_.countLanes && !o_.cpu)
-        std::fprintf(stderr, "snell: lanes busy: trace loop %.1f %% of %llu slots, BVH walk %.1f %% of %llu\n",
-                     100.0 * share(outcome.lanes.traceBusy, outcome.lanes.traceSlots),
-                     static_cast<unsigned long long>(outcome.lanes.traceSlots),
-                     100.0 * share(outcome.lanes.walkBusy, outcome.lanes.walkSlots),
-                     static_cast<unsigned long long>(outcome.lanes.walkSlots));
+        printVerbose(output, request, outcome, o_.cpu ? "CPU reference" : o_.device.precision, parseMs,
+                     {stream.encodeMs(), stream.blockedMs(), stream.beside()}, msSince(totalStart), o_.countLanes);
     if (o_.stats) {
         // With the image on standard output, the statistics go to standard error.
         std::ostream& out = output == kStandardOutput ? std::cerr : std::cout;
@@ -338,6 +251,22 @@ int RenderCommand::run() {
             << std::endl;
     }
     return kExitSuccess;
+}
+
+// The options that choose how the GPU renders do nothing for the CPU
+// reference: given with --cpu they are a mistake, refused rather than
+// ignored. Their environment variables are standing preferences, not
+// refused (and not read).
+void RenderCommand::refuseGpuOptions() const {
+    std::vector<std::string> given = o_.device.given();
+    if (o_.countLanes) given.push_back("--count-lanes");
+    if (given.empty()) return;
+    std::string names;
+    for (std::size_t i = 0; i < given.size(); ++i)
+        names += (i == 0 ? "" : i + 1 == given.size() ? " and " : ", ") + given[i];
+    throw InputError(names + (given.size() > 1 ? " apply" : " applies") +
+                     " to GPU renders only, and --cpu renders with the CPU reference (double precision, on the "
+                     "host's cores): drop " + (given.size() > 1 ? "them" : "it") + " or --cpu");
 }
 
 TraceSettings RenderCommand::traceSettings() const {
@@ -398,18 +327,42 @@ RenderOutcome RenderCommand::renderOnCpu(const Scene& scene, RenderRequest& requ
     CpuRenderer renderer(scene);
     stream.encodeBeside(true);
     if (progress.enabled())
-        estimateCost(scene, request, rowBands(request.area()), progress, r, [&](const RenderRequest& probe) {
-            const auto start = Clock::now();
-            RayCounts rays;
-            renderer.render(probe, &rays);
-            return std::pair(msSince(start), double(rays.total()));
+        progress.during(kProbing, [&] {
+            auto probe = [&](const RenderRequest& sparse) {
+                const auto start = Clock::now();
+                RayCounts rays;
+                renderer.render(sparse, &rays);
+                return std::pair(msSince(start), double(rays.total()));
+            };
+            estimateCost(scene, request, rowBands(request.area()), progress, r.estimateMs, probe);
         });
+    progress.renderStarts();
     const auto start = Clock::now();
     renderer.render(request, &r.rays);
     r.renderMs = msSince(start) - stream.blockedMs();
     r.device = "CPU reference (double, " + std::to_string(std::max(1u, std::thread::hardware_concurrency())) +
                " threads)";
     return r;
+}
+
+void RenderCommand::estimateGpuCost(const Scene& scene, RenderRequest& request, ComputeRenderer& renderer,
+                                    Progress& progress, RenderOutcome& r, CostMap& expectedCost) const {
+    auto probe = [&](const RenderRequest& sparse) {
+        const GpuRenderResult g = renderer.render(sparse, o_.stats);
+        r.pipelineMs += g.pipelineMs;
+        return std::pair(g.renderMs, double(g.tracedRays));
+    };
+    // A render long enough for its time left to matter is traced in
+    // interleaved tiles (their probe is one sparse render of the whole); a
+    // short one in blocks, which is cheaper on cheap scenes.
+    const PixelWindow area = request.area();
+    request.interleavedTiles = ComputeRenderer::interleaves(area);
+    const double seconds = estimateCost(scene, request, ComputeRenderer::tiles(area, request.interleavedTiles),
+                                        progress, r.estimateMs, probe, &expectedCost);
+    if (request.interleavedTiles && seconds < kInterleaveFrom) {
+        request.interleavedTiles = false;
+        estimateCost(scene, request, ComputeRenderer::tiles(area, false), progress, r.estimateMs, probe, &expectedCost);
+    }
 }
 
 RenderOutcome RenderCommand::renderOnGpu(const Scene& scene, RenderRequest& request, OutputStream& stream,
@@ -427,29 +380,17 @@ RenderOutcome RenderCommand::renderOnGpu(const Scene& scene, RenderRequest& requ
         if (const std::uint32_t budget = loopBudgetOverride()) rendererOptions.loopBudget = budget;
         rendererOptions.countLanes = o_.countLanes;
         ComputeRenderer renderer(context, scene, request.camera, rendererOptions);
-        // The probe compiles the pipeline, which belongs to pipelineMs: the
-        // render's own (the same specialisation, counting rays only as the
-        // render does), so the render reuses it rather than compiling a second
-        // one (seconds on a cold shader cache) inside the time the bar counts.
+        // The kernel first, compiled for a new scene structure (seconds on
+        // lavapipe) and said so on the bar's line; the probe and the render
+        // reuse it (the same specialisation), and neither's time counts it.
+        const auto kernelStart = Clock::now();
+        progress.during("compiling the kernel for this scene", [&] { renderer.prepare(request, o_.stats); });
+        r.pipelineMs = msSince(kernelStart);
+        r.kernelCached = !options.pipelineCachePath.empty();
         CostMap expectedCost;
-        if (progress.enabled()) {
-            auto probe = [&](const RenderRequest& sparse) {
-                const GpuRenderResult g = renderer.render(sparse, o_.stats);
-                r.pipelineMs += g.pipelineMs;
-                return std::pair(g.renderMs, double(g.tracedRays));
-            };
-            // A render long enough for its time left to matter is traced in
-            // interleaved tiles (their probe is one sparse render of the
-            // whole); a short one in blocks, which is cheaper on cheap scenes.
-            const PixelWindow area = request.area();
-            request.interleavedTiles = ComputeRenderer::interleaves(area);
-            const double seconds = estimateCost(scene, request, ComputeRenderer::tiles(area, request.interleavedTiles),
-                                                progress, r, probe, &expectedCost);
-            if (request.interleavedTiles && seconds < kInterleaveFrom) {
-                request.interleavedTiles = false;
-                estimateCost(scene, request, ComputeRenderer::tiles(area, false), progress, r, probe, &expectedCost);
-            }
-        }
+        if (progress.enabled())
+            progress.during(kProbing, [&] { estimateGpuCost(scene, request, renderer, progress, r, expectedCost); });
+        progress.renderStarts();
         if (!expectedCost.empty()) request.expectedCost = &expectedCost;
         const GpuRenderResult g = renderer.render(request, o_.stats);
         request.expectedCost = nullptr;  // expectedCost ends here
@@ -503,7 +444,7 @@ std::string RenderCommand::statsJson(const Scene& scene, const RenderRequest& re
       << ", \"kernel\": \"" << r.kernel << "\", \"kernel_object\": \"" << r.kernelObject << "\""
       << ", \"width\": " << request.width << ", \"height\": " << request.height
       << ", \"supersample\": " << request.supersample << ", \"max_depth\": " << request.trace.maxDepth
-      << ", \"min_weight\": " << request.trace.minWeight << ", \"spheres\": " << scene.spheres.size()
+      << ", \"min_weight\": " << exactNumber(request.trace.minWeight) << ", \"spheres\": " << scene.spheres.size()
       << ", \"true_spheres\": " << scene.spheres.size() - scene.ellipsoidCount()
       << ", \"ellipsoids\": " << scene.ellipsoidCount() << ", \"lights\": " << scene.lights.size()
       << ", \"parse_ms\": " << parseMs << ", \"upload_ms\": " << r.uploadMs << ", \"pipeline_ms\": " << r.pipelineMs
@@ -515,7 +456,8 @@ std::string RenderCommand::statsJson(const Scene& scene, const RenderRequest& re
       << ", \"rays\": {\"primary\": " << r.rays.primary << ", \"shadow\": " << r.rays.shadow
       << ", \"reflected\": " << r.rays.reflected << ", \"refracted\": " << r.rays.refracted
       << ", \"total\": " << r.rays.total() << "}"
-      << ", \"tolerance\": " << request.trace.tolerance << ", \"truncation\": " << truncationJson(truncation_);
+      << ", \"tolerance\": " << exactNumber(request.trace.tolerance)
+      << ", \"truncation\": " << truncationJson(truncation_);
     if (o_.countLanes && !o_.cpu)
         j << ", \"lanes\": {\"trace_slots\": " << r.lanes.traceSlots << ", \"trace_busy\": " << r.lanes.traceBusy
           << ", \"trace_occupancy\": " << share(r.lanes.traceBusy, r.lanes.traceSlots)
@@ -531,7 +473,7 @@ OutputStream::OutputStream(const std::string& path, const Scene& scene, const Re
     const std::string settings =
         "size " + std::to_string(request.width) + ", supersample " + std::to_string(request.supersample) +
         ", depth " + std::to_string(request.trace.maxDepth) + ", min-weight " +
-        std::to_string(request.trace.minWeight) + ", " + (o.cpu ? "CPU reference" : "GPU " + o.device.precision);
+        exactNumber(request.trace.minWeight) + ", " + (o.cpu ? "CPU reference" : "GPU " + o.device.precision);
     ImageText text{{"Title", scene.name},
                    {"Source", sceneFile(o.scene)},
                    {"Software", std::string("snell ") + SNELL_VERSION},
@@ -566,7 +508,8 @@ void OutputStream::encodeBeside(bool cpuRenderer) {
     // Measured on lavapipe (2 cores): a thread that encodes EXR beside the
     // render saves more than it slows the render; one that encodes PNG slows
     // it more than it saves. A GPU leaves the cores to the encoder.
-    if (!cpuRenderer || format_ == ImageFormat::Exr) writer_->start();
+    beside_ = !cpuRenderer || format_ == ImageFormat::Exr;
+    if (beside_) writer_->start();
 }
 
 void OutputStream::commit() {

@@ -13,7 +13,8 @@ std::string unknownSubcommand(const CLI::App& app, const std::string& word) {
     for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; }))
         names.push_back(sub->get_name());
     const std::string_view best = nearestName(word, names, allowedEdits(word));
-    if (!best.empty()) return "unknown command '" + word + "'; did you mean '" + std::string(best) + "'?";
+    if (!best.empty())
+        return "unknown command '" + word + "'; did you mean '" + std::string(best) + "'? (snell --help lists them)";
     std::string list;
     for (const std::string& n : names) list += (list.empty() ? "" : ", ") + n;
     return "unknown command '" + word + "' (commands: " + list + "; snell --help says more)";

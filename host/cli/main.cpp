@@ -9,7 +9,7 @@
 
 #include "cli/Command.h"
 #include "cli/ExitStatus.h"
-#include "cli/Suggest.h"
+#include "cli/OptionErrors.h"
 #include "vulkan/VulkanContext.h"
 
 #ifndef SNELL_VERSION
@@ -22,7 +22,7 @@ using namespace snell::cli;
 
 const char* kExitStatuses =
     "Exit status: 0 success; 1 runtime failure (no Vulkan device, device lost, unwritable output);\n"
-    "2 bad scene file or command line (the message is FILE:LINE:COL: error: ...); 128+N ended by signal N "
+    "2 bad scene file (FILE:LINE:COL: error: ...) or command line (snell: error: ...); 128+N ended by signal N "
     "(Ctrl-C: 130).\ncompare: 0 the images agree, 1 they differ, 2 trouble.";
 
 std::string versionText() {
@@ -61,9 +61,8 @@ int main(int argc, char** argv) {
     } catch (const CLI::CallForAllHelp& e) {
         return app.exit(e);
     } catch (const CLI::ParseError& e) {
-        // A misspelt subcommand or option gets a suggestion, as scene typos do.
-        if (const std::string hint = suggestFor(app, e); !hint.empty()) std::cerr << "snell: error: " << hint << "\n";
-        else app.exit(e);
+        // One voice: the option library's errors read as snell's own.
+        std::cerr << "snell: error: " << describeParseError(app, e) << "\n";
         return kExitInput;
     }
     if (version) {

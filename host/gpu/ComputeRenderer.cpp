@@ -61,6 +61,29 @@ gpu::Kernel& ComputeRenderer::ensureKernel(const gpu::Specialisation& values, bo
     return *cached_;
 }
 
+gpu::Kernel& ComputeRenderer::readyKernel(const RenderRequest& request, const gpu::Specialisation& values,
+                                          const gpu::TilePlan& plan, bool& created) {
+    gpu::Kernel& k = ensureKernel(values, created);
+    gpu::FrameParams frameLow{};
+    const gpu::FrameParams frame = gpu::makeFrameParams(scene_, layout_, request, &frameLow);
+    gpu::prepareBuffers(context_, k, *sceneBuffers_, frame, frameLow, plan.invocations, plan.tilePixels());
+    if (created) gpu::firstDispatch(context_, k);
+    return k;
+}
+
+bool ComputeRenderer::prepare(const RenderRequest& request, bool countRays) {
+    try {
+        const gpu::Specialisation values = gpu::specialise(scene_, layout_, policy_, request, countRays);
+        const bool wide = layout_.precision == gpu::Precision::Fp64;
+        bool created = false;
+        readyKernel(request, values, gpu::planTiles(context_, request, values, wide, policy_.planForCpu), created);
+        return created;
+    } catch (...) {
+        dropKernel();
+        throw;
+    }
+}
+
 // Plan the tiles, make sure of the kernel and its buffers, then each tile:
 // dispatch it and read it back (streaming a band of tiles at a time).
 GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool countRays) {
@@ -73,11 +96,7 @@ GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool count
         result.invocations = static_cast<int>(plan.invocations);
         result.interleaved = plan.interleaved;
         bool created = false;
-        gpu::Kernel& k = ensureKernel(values, created);
-        gpu::FrameParams frameLow{};
-        const gpu::FrameParams frame = gpu::makeFrameParams(scene_, layout_, request, &frameLow);
-        gpu::prepareBuffers(context_, k, *sceneBuffers_, frame, frameLow, plan.invocations, plan.tilePixels());
-        if (created) gpu::firstDispatch(context_, k);
+        gpu::Kernel& k = readyKernel(request, values, plan, created);
         result.pipelineMs = msSince(pipelineStart);
 
         const PixelWindow& area = plan.area;

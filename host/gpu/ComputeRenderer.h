@@ -47,6 +47,11 @@ public:
     // origin chosen for the construction camera). The kernel and tile
     // buffers are kept for the next render, which reuses them when it can.
     GpuRenderResult render(const RenderRequest& request, bool countRays);
+    // Builds the kernel that render(request, countRays) will use, so that
+    // its compile (seconds on lavapipe for a new scene structure, where no
+    // cache holds it) can be announced and timed apart from the render.
+    // Returns true where it built one, false where the last render's serves.
+    bool prepare(const RenderRequest& request, bool countRays);
 
     // The largest tile side: an image is rendered (and streamed) tile by tile.
     static constexpr int kMaxTileSide = gpu::kMaxTileSide;
@@ -80,6 +85,10 @@ public:
 
 private:
     gpu::Kernel& ensureKernel(const gpu::Specialisation& values, bool& created);
+    // The kernel and its buffers for `request`, as planned (its first,
+    // compiling dispatch done where it is new).
+    gpu::Kernel& readyKernel(const RenderRequest& request, const gpu::Specialisation& values,
+                             const gpu::TilePlan& plan, bool& created);
     void dropKernel();
 
     vk::Context& context_;
