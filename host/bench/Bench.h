@@ -11,10 +11,10 @@
 // dispatch time over that of the fastest fixed tree (tolerance 0: a weight
 // cut-off 4^-k, or a depth cap without one) whose measured error is no worse,
 // swept in order of growing cost and stopped where no later tree could set
-// the price (an upper bound where none tried is as accurate); the geometric
-// mean and the worst scene close the log. Writes bench.csv and bench.json,
-// and with bench/summarize.py bench.md (tables) and bench.png (the plot);
-// ends with a summary table.
+// the price (an upper bound where none tried is as accurate). Writes
+// bench.csv and bench.json, and with bench/summarize.py bench.md (tables)
+// and bench.png (the plot); ends with a summary table, closed by the
+// price's geometric mean and the worst scene.
 #pragma once
 
 #include <atomic>
