@@ -65,16 +65,7 @@ def tables(d):
               f"{100 * b['error']['bad_fraction']:.3f} | {ms(b['dispatch_ms']['median'])} |")
 
     if d["peers"]:
-        print("\n| bench scene | size | snell dispatch ms | snell command ms | first image cold / warm ms | "
-              "CPU reference ms | POV-Ray trace ms | POV-Ray command ms | trace ratio | command ratio |")
-        print("|---|---|---|---|---|---|---|---|---|---|")
-        for p in d["peers"]:
-            pt, pc = p["povray_trace_ms"], p["povray_command_ms"]
-            trace_ratio = "–" if pt is None else f"{pt / p['snell_dispatch_ms']:.2f}×"
-            command_ratio = "–" if pc is None else f"{pc / p['snell_command_ms']:.2f}×"
-            print(f"| {p['scene']} | {p['size']}² | {ms(p['snell_dispatch_ms'])} | {ms(p['snell_command_ms'])} | "
-                  f"{ms(p['first_image_cold_ms'])} / {ms(p['first_image_warm_ms'])} | {ms(p['cpu_reference_ms'])} | "
-                  f"{ms(pt)} | {ms(pc)} | {trace_ratio} | {command_ratio} |")
+        peers(d["peers"])
 
     if d.get("walk_floors"):
         print("\n| BVH scene (depth 0) | size | walk's floor ms | Mrays/s | renderer ms | Mrays/s | renderer / floor |")
@@ -100,6 +91,56 @@ def tables(d):
         print(f"Floor at {f['size']}²: a kernel that only stores each pixel {ms(f['store_kernel_ms'])} ms; "
               f"the renderer on an empty scene {ms(f['empty_scene_ms'])} ms "
               f"({f['empty_scene_ms'] / f['store_kernel_ms']:.1f}×).")
+
+
+def ratio(a, half_step, b):
+    """a / b where a is known only to ±half_step (POV-Ray prints its trace time in whole ms): to three digits,
+    or two, where the step allows them, else the range it leaves (as snell bench's log)."""
+    if a is None or not b:
+        return "–"
+
+    def digits(v, n):  # n significant digits, trailing zeros kept
+        return f"{v:.{max(0, n - 1 - math.floor(math.log10(v))) if v > 0 else n}f}"
+
+    u = half_step / a if a > 0 else math.inf
+    if u <= 5e-3:
+        return digits(a / b, 3 if u <= 5e-4 else 2) + "×"
+    low, high = digits(max(0.0, a - half_step) / b, 2), digits((a + half_step) / b, 2)
+    if a <= half_step:
+        return f"below {high}×"
+    return f"{high}×" if low == high else f"{low}–{high}×"
+
+
+def agreement(p):
+    """POV-Ray's image against snell's, where the two models agree (opaque spheres)."""
+    a = p.get("povray_agreement")
+    if not a:
+        return "–"
+    if not a["compared"]:
+        return a["note"]
+    e, c = a["error"], a["cpu_reference_error"]
+    text = (f"mean {e['mean_abs_error']:.3f}/255, max {e['max_error']}/255, {100 * e['bad_fraction']:.2f} % over "
+            f"3/255: {'agrees' if a['agrees'] else 'differs'} (the CPU reference's: mean "
+            f"{c['mean_abs_error']:.3f}/255, max {c['max_error']}/255)")
+    return text + (f"; {a['note']}" if a["note"] else "")
+
+
+def peers(rows):
+    """The peers on the bench scenes: the same tree in each (snell's depth, POV-Ray's max_trace_level one more)."""
+    print("\n| bench scene | size | depth / POV-Ray level | snell dispatch ms | snell command ms | "
+          "first image cold / warm ms | CPU reference ms | POV-Ray trace ms | POV-Ray command ms | trace ratio | "
+          "command ratio | POV-Ray's image against snell's |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+    for p in rows:
+        pt, pc = p["povray_trace_ms"], p["povray_command_ms"]
+        step = p.get("povray_trace_resolution_ms", 1.0) or 0.0  # POV-Ray prints whole ms
+        command_ratio = "–" if pc is None else f"{pc / p['snell_command_ms']:.2f}×"
+        level = f"{p['depth']} / {p['povray_max_trace_level']}" if "depth" in p else "5 / 5"
+        trace = "–" if pt is None else f"{pt:g}" + (f" (to {step:g})" if step else "")
+        print(f"| {p['scene']} | {p['size']}² | {level} | {ms(p['snell_dispatch_ms'])} | "
+              f"{ms(p['snell_command_ms'])} | {ms(p['first_image_cold_ms'])} / {ms(p['first_image_warm_ms'])} | "
+              f"{ms(p['cpu_reference_ms'])} | {trace} | {ms(pc)} | {ratio(pt, step / 2, p['snell_dispatch_ms'])} | "
+              f"{command_ratio} | {agreement(p)} |")
 
 
 def price(p):

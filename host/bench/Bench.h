@@ -3,16 +3,18 @@
 // times the dispatches by GPU timestamps (median and range of several runs
 // after a warm-up), measures the error against the converged CPU reference,
 // and records the peers of the same run: the CPU reference itself (converged,
-// and at the GPU's default settings), POV-Ray 3.7 on the shared bench scenes,
+// and at the GPU's default settings), POV-Ray 3.7 on the shared bench scenes
+// (the same tree, and its image against snell's where the models agree),
 // the device's ray–sphere ceiling and store-only floor, the BVH walk's floor
 // on each BVH scene (its rays walked alone, beside the renderer), and the render time
 // against sphere count. It prices the default settings per scene: their
 // dispatch time over that of the fastest fixed tree (tolerance 0: a weight
 // cut-off 4^-k, or a depth cap without one) whose measured error is no worse,
 // swept in order of growing cost and stopped where no later tree could set
-// the price (an upper bound where none tried is as accurate); the geometric
-// mean and the worst scene close the log. Writes bench.csv and bench.json;
-// bench/summarize.py turns them into tables and a plot.
+// the price (an upper bound where none tried is as accurate). Writes
+// bench.csv and bench.json, and with bench/summarize.py bench.md (tables)
+// and bench.png (the plot); ends with a summary table, closed by the
+// price's geometric mean and the worst scene.
 #pragma once
 
 #include <atomic>
@@ -25,8 +27,8 @@ namespace snell {
 
 struct BenchOptions {
     std::vector<std::string> scenes;  // files or directories; empty: the default set
-    bool quick = false;               // fewer settings, smaller images (CI)
-    int size = 0;                     // image side; 0: 128 (quick: 48)
+    bool quick = false;               // two scenes, fewer settings, smaller images (CI, a first look)
+    int size = 0;                     // image side; 0: 128 (quick: 32)
     int runs = 5;                     // timed runs per setting, after one warm-up
     std::string outDir = "bench/results";
     std::string sourceDir;            // the repository (scenes/, bench/make_scaling_scene.py)
@@ -42,8 +44,9 @@ public:
     using std::runtime_error::runtime_error;
 };
 
-// Runs the benchmark, logging progress to `log`. Throws BenchError,
-// vk::VulkanError, ParseError (a scene of the set), ImageIOError.
-void runBench(const BenchOptions& options, std::ostream& log);
+// Runs the benchmark, logging progress to `log`, and ends with a table of
+// the results on `summary`. Throws BenchError, vk::VulkanError, ParseError
+// (a scene of the set), ImageIOError.
+void runBench(const BenchOptions& options, std::ostream& log, std::ostream& summary);
 
 }  // namespace snell

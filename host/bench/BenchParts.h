@@ -5,6 +5,7 @@
 #include <atomic>
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -54,12 +55,41 @@ struct Result {
     std::string failure;  // the renderer refused or failed: no numbers
 };
 
+// A CPU render's time, taken as the GPU's are: the median of several renders
+// after an untimed one (threads, caches and the scene's traps warmed), or
+// that one alone where it took kCpuSingleRunMs or more. A render of a
+// millisecond on its threads takes ten when the scheduler keeps one waiting
+// on a busy machine: at least `runs`, as many as fill kCpuBudgetMs.
+struct CpuTiming {
+    Stats ms;
+    int runs = 0;
+};
+constexpr double kCpuSingleRunMs = 500.0, kCpuBudgetMs = 200.0;
+constexpr int kCpuMaxRuns = 101;
+
+// POV-Ray's image against snell's at the same tree (PovExport.h), in 1/255:
+// compared only where the two models agree (povModelAgrees), else `note` says why not.
+struct PovAgreement {
+    bool compared = false;
+    ImageMetrics metrics;     // POV-Ray's image against snell's (the GPU's, fp32)
+    ImageMetrics cpuMetrics;  // against the CPU reference's at the same tree (double precision)
+    bool agrees = false;      // metrics within `snell compare`'s defaults: mean 0.5/255, 0.1 % of pixels over 3/255
+    std::string note;
+};
+
+// The peers on one shared bench scene, all tracing the same tree: snell's
+// depth kPeerDepth without a cut-off, one ray a pixel, POV-Ray's
+// max_trace_level one more (it counts the camera ray).
+constexpr int kPeerDepth = 5;
 struct Peer {
     std::string scene;
     int size = 0;
-    double snellDispatchMs = 0.0, snellCommandMs = 0.0, coldMs = 0.0, warmMs = 0.0, cpuMs = 0.0;
+    double snellDispatchMs = 0.0, snellCommandMs = 0.0, coldMs = NAN, warmMs = 0.0;  // cold: NaN in a quick run
+    CpuTiming cpu;
     std::optional<double> povTraceMs, povCommandMs;
+    double povTraceResolutionMs = 0.0;  // POV-Ray prints its trace time to this step
     std::string povNote;
+    PovAgreement agreement;
 };
 
 struct Scaling {
@@ -157,12 +187,21 @@ struct Collected {
     std::vector<Peer> peers;
     std::vector<Scaling> scaling;
     std::vector<WalkFloor> walkFloors;
-    std::map<std::string, double> referenceMs, cpuDefaultMs;
+    std::map<std::string, CpuTiming> referenceMs, cpuDefaultMs;
 };
 
 // Statistics and subprocesses (BenchStatistics.cpp)
 Stats stats(std::vector<double> v);
 std::string number(double v);
+CpuTiming timeCpu(const std::function<void()>& render, double firstMs, int runs);
+// Two renders timed in turn (a, b, a, b, ...), so that the machine's drift moves both alike.
+std::pair<CpuTiming, CpuTiming> timeCpuSideBySide(const std::function<void()>& a, double firstA,
+                                                  const std::function<void()>& b, double firstB, int runs);
+std::string describe(const CpuTiming& t);  // "0.31 ms (median of 5)"
+// a / b where a is known only to ±halfStep (a time printed to a step): to
+// three digits, or two, where the step allows them, else the range it leaves
+// ("2.6-3.6x"; "below 4.1x" where a may be 0).
+std::string ratioText(double a, double halfStep, double b);
 double peakRssMiB();
 double runCommand(const std::string& command, std::string* output = nullptr);
 std::string quote(const std::string& s);
@@ -189,6 +228,12 @@ PriceSummary summarizePrices(const std::vector<Price>& prices);
 // Peers: the CPU reference and POV-Ray on the shared bench scenes (Peers.cpp)
 Peer measurePeer(vk::Context& context, const BenchOptions& o, const SceneFile& file, const Scene& scene,
                  const CpuRenderer& cpu, const RenderRequest& base, int runs, std::ostream& log);
+// "mean 0.01/255, max 2/255, 0 pixels (0.00 %) over 3/255: agrees", or why not compared
+std::string describe(const PovAgreement& a);
+
+// The end of a run: the summary table, bench.md and bench.png (Summary.cpp)
+void printSummary(const Collected& c, int size, bool gpuTimed, std::ostream& out);
+void writeTablesAndPlot(const BenchOptions& o, std::ostream& log);
 
 // The report: bench.csv and bench.json (Report.cpp)
 void writeCsv(const fs::path& path, const Collected& c, const Ceiling& ceiling);

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
 #include <sstream>
 
 #include <cstdio>
@@ -29,6 +30,62 @@ std::string number(double v) {
     return s.str();
 }
 
+
+namespace {
+
+// Timed renders of one that took firstMs: none where it took kCpuSingleRunMs
+// or more, else at least `runs`, and as many as fill kCpuBudgetMs.
+int cpuRuns(double firstMs, int runs) {
+    if (firstMs >= kCpuSingleRunMs) return 0;
+    return std::clamp(int(std::ceil(kCpuBudgetMs / std::max(firstMs, 1e-3))), runs, std::max(runs, kCpuMaxRuns));
+}
+
+double timeOnce(const std::function<void()>& render) {
+    const auto start = Clock::now();
+    render();
+    return msSince(start);
+}
+
+}  // namespace
+
+CpuTiming timeCpu(const std::function<void()>& render, double firstMs, int runs) {
+    const int n = cpuRuns(firstMs, runs);
+    if (n == 0) return {{firstMs, firstMs, firstMs}, 1};
+    std::vector<double> ms;
+    for (int k = 0; k < n; ++k) ms.push_back(timeOnce(render));
+    return {stats(ms), n};
+}
+
+std::pair<CpuTiming, CpuTiming> timeCpuSideBySide(const std::function<void()>& a, double firstA,
+                                                  const std::function<void()>& b, double firstB, int runs) {
+    const int n = std::min(cpuRuns(firstA, runs), cpuRuns(firstB, runs));
+    if (n == 0) return {timeCpu(a, firstA, runs), timeCpu(b, firstB, runs)};
+    std::vector<double> msA, msB;
+    for (int k = 0; k < n; ++k) {
+        msA.push_back(timeOnce(a));
+        msB.push_back(timeOnce(b));
+    }
+    return {{stats(msA), n}, {stats(msB), n}};
+}
+
+std::string describe(const CpuTiming& t) {
+    return number(t.ms.median) + " ms" + (t.runs > 1 ? " (median of " + std::to_string(t.runs) + ")" : "");
+}
+
+std::string ratioText(double a, double halfStep, double b) {
+    if (!(a >= 0.0) || !(b > 0.0)) return "null";
+    auto digits = [](double v, int n) {  // n significant digits, trailing zeros kept
+        std::ostringstream s;
+        s << std::fixed << std::setprecision(v > 0.0 ? std::max(0, n - 1 - int(std::floor(std::log10(v)))) : n);
+        s << v;
+        return s.str();
+    };
+    const double u = halfStep / a;  // a's relative uncertainty
+    if (u <= 5e-3) return digits(a / b, u <= 5e-4 ? 3 : 2) + "x";
+    const std::string low = digits(std::max(0.0, a - halfStep) / b, 2), high = digits((a + halfStep) / b, 2);
+    if (a <= halfStep) return "below " + high + "x";
+    return low == high ? high + "x" : low + "-" + high + "x";  // two digits where both ends round to them
+}
 
 double peakRssMiB() {
     rusage u{};

@@ -27,7 +27,7 @@ Ceiling measureCeiling(vk::Context& context, int runs, bool quick) {
         t.scale(dvec3(0.15, 0.1, 0.2));
         spheres[k].objectFromWorld = glm::mat4(t.objectFromWorld());
     }
-    const std::uint32_t rays = quick ? (1u << 18) : (1u << 20);
+    const std::uint32_t rays = quick ? (1u << 16) : (1u << 20);
     vk::Buffer input = context.createBufferWithData(spheres.data(), spheres.size() * sizeof spheres[0],
                                                     VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
     vk::Buffer output = context.createBuffer(rays * sizeof(float), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, vk::Context::Memory::Device);

@@ -15,12 +15,13 @@ std::string vec(const dvec3& v) {
 
 }  // namespace
 
-std::string toPovRay(const Scene& scene, int maxTraceLevel) {
+std::string toPovRay(const Scene& scene, int depth) {
     std::ostringstream out;
     out.precision(17);
     out << "// " << scene.name << ", written by snell bench\n"
         << "#version 3.7;\n"
-        << "global_settings { max_trace_level " << maxTraceLevel << " adc_bailout 0 assumed_gamma 1.0 ambient_light rgb "
+        << "global_settings { max_trace_level " << povTraceLevel(depth)
+        << " adc_bailout 0 assumed_gamma 1.0 ambient_light rgb "
         << vec(scene.ambient) << " }\n"
         << "background { rgb " << vec(scene.background) << " }\n";
     // SPEC §3: eye (0,0,1) looking down -z at the image plane z = 0, half-width d.
@@ -44,6 +45,12 @@ std::string toPovRay(const Scene& scene, int maxTraceLevel) {
         out << "}\n";
     }
     return out.str();
+}
+
+bool povModelAgrees(const Scene& scene) {
+    for (const Sphere& s : scene.spheres)
+        if (scene.materials[s.material].refracts()) return false;
+    return true;
 }
 
 }  // namespace snell

@@ -7,6 +7,7 @@
 
 #include <fstream>
 
+#include "bench/PovExport.h"
 #include "common/Json.h"
 
 namespace snell::bench {
@@ -66,8 +67,10 @@ void writeResultJson(std::ostream& json, const Result& r, const Collected& c) {
          << ", \"mean\": " << number(255.0 * r.bound.meanBound()) << ", \"unbounded_pixels\": " << r.bound.unbounded
          << ", \"estimated_pixels\": " << r.bound.estimated << ", \"over_tolerance_pixels\": "
          << r.bound.overTolerance << ", \"over_budget_pixels\": " << r.bound.overBudget << "}"
-         << ", \"reference_ms\": " << number(c.referenceMs.at(r.scene))
-         << ", \"cpu_default_ms\": " << number(c.cpuDefaultMs.at(r.scene))
+         << ", \"reference_ms\": " << number(c.referenceMs.at(r.scene).ms.median)
+         << ", \"reference_runs\": " << c.referenceMs.at(r.scene).runs
+         << ", \"cpu_default_ms\": " << number(c.cpuDefaultMs.at(r.scene).ms.median)
+         << ", \"cpu_default_runs\": " << c.cpuDefaultMs.at(r.scene).runs
          << ", \"failure\": " << jsonString(r.failure) << "}";
 }
 
@@ -91,6 +94,26 @@ void writePriceSummaryJson(std::ostream& json, const PriceSummary& s) {
          << ", \"worst_price\": " << (s.worst ? number(s.worst->price) : "null")
          << ", \"worst_is_upper_bound\": " << (s.worst && s.worst->upperBound ? "true" : "false")
          << ", \"worst_fixed_setting\": " << (s.worst ? jsonString(s.worst->fixed) : "null") << "}";
+}
+
+void writePeerJson(std::ostream& json, const Peer& p) {
+    const PovAgreement& a = p.agreement;
+    json << "    {\"scene\": " << jsonString(p.scene) << ", \"size\": " << p.size << ", \"depth\": " << kPeerDepth
+         << ", \"povray_max_trace_level\": " << povTraceLevel(kPeerDepth) << ", \"samples_per_pixel\": 1"
+         << ", \"snell_dispatch_ms\": " << number(p.snellDispatchMs)
+         << ", \"snell_command_ms\": " << number(p.snellCommandMs) << ", \"first_image_cold_ms\": "
+         << number(p.coldMs) << ", \"first_image_warm_ms\": " << number(p.warmMs)
+         << ", \"cpu_reference_ms\": " << number(p.cpu.ms.median) << ", \"cpu_reference_runs\": " << p.cpu.runs
+         << ", \"povray_trace_ms\": " << (p.povTraceMs ? number(*p.povTraceMs) : "null")
+         << ", \"povray_trace_resolution_ms\": " << (p.povTraceMs ? number(p.povTraceResolutionMs) : "null")
+         << ", \"povray_command_ms\": " << (p.povCommandMs ? number(*p.povCommandMs) : "null")
+         << ", \"note\": " << jsonString(p.povNote) << ", \"povray_agreement\": {\"compared\": "
+         << (a.compared ? "true" : "false");
+    // POV-Ray's image against snell's, in ImageMetrics' terms (1/255).
+    if (a.compared)
+        json << ", \"agrees\": " << (a.agrees ? "true" : "false") << ", \"error\": " << a.metrics.json()
+             << ", \"cpu_reference_error\": " << a.cpuMetrics.json();
+    json << ", \"note\": " << jsonString(a.note) << "}}";
 }
 
 // bench.json: everything, for tools.
@@ -117,15 +140,8 @@ void writeJson(const fs::path& path, const Collected& c, const Ceiling& ceiling,
     writePriceSummaryJson(json, summarizePrices(c.prices));
     json << ",\n  \"peers\": [\n";
     for (std::size_t i = 0; i < c.peers.size(); ++i) {
-        const Peer& p = c.peers[i];
-        json << "    {\"scene\": " << jsonString(p.scene) << ", \"size\": " << p.size
-             << ", \"snell_dispatch_ms\": " << number(p.snellDispatchMs)
-             << ", \"snell_command_ms\": " << number(p.snellCommandMs) << ", \"first_image_cold_ms\": "
-             << number(p.coldMs) << ", \"first_image_warm_ms\": " << number(p.warmMs)
-             << ", \"cpu_reference_ms\": " << number(p.cpuMs)
-             << ", \"povray_trace_ms\": " << (p.povTraceMs ? number(*p.povTraceMs) : "null")
-             << ", \"povray_command_ms\": " << (p.povCommandMs ? number(*p.povCommandMs) : "null")
-             << ", \"note\": " << jsonString(p.povNote) << "}" << (i + 1 < c.peers.size() ? "," : "") << "\n";
+        writePeerJson(json, c.peers[i]);
+        json << (i + 1 < c.peers.size() ? "," : "") << "\n";
     }
     json << "  ],\n  \"walk_floors\": [\n";
     for (std::size_t i = 0; i < c.walkFloors.size(); ++i) {

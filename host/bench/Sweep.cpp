@@ -9,18 +9,13 @@
 
 namespace snell::bench {
 
+// A quick run (CI, a first look) sweeps the default and a tolerance of
+// 2/255, which share its kernels (the fixed sweep adds cut-offs and depth
+// caps); the other settings, fp64 and the other BVH mode each need kernels
+// of their own, seconds each to compile on lavapipe.
 std::vector<Setting> settingsFor(const Scene& scene, bool quick, bool fp64) {
     std::vector<Setting> s;
     s.push_back({"default"});
-    // Depth alone (no cut-off): at most 2^depth rays a pixel, so it stays small.
-    const std::vector<int> depths = quick ? std::vector<int>{1, 5} : std::vector<int>{1, 2, 3, 5, 8};
-    for (int d : depths) {
-        Setting x{"depth " + std::to_string(d)};
-        x.depth = d;
-        x.minWeight = 0.0;
-        x.tolerance = 0.0;
-        s.push_back(x);
-    }
     // The tolerance on each pixel's stated bound (the default is 0.5/255).
     for (double t : quick ? std::vector<double>{2.0} : std::vector<double>{8.0, 2.0, 0.1}) {
         std::ostringstream name;
@@ -29,9 +24,22 @@ std::vector<Setting> settingsFor(const Scene& scene, bool quick, bool fp64) {
         x.tolerance = t / 255.0;
         s.push_back(x);
     }
+    if (scene.supersample > 1) {
+        Setting one{"spp 1"};
+        one.supersample = 1;
+        s.push_back(one);
+    }
+    if (quick) return s;
+    // Depth alone (no cut-off): at most 2^depth rays a pixel, so it stays small.
+    for (int d : {1, 2, 3, 5, 8}) {
+        Setting x{"depth " + std::to_string(d)};
+        x.depth = d;
+        x.minWeight = 0.0;
+        x.tolerance = 0.0;
+        s.push_back(x);
+    }
     // The cut-off at full depth (0 is left out: a glass scene's tree then has 2^64 rays).
-    const std::vector<double> weights = quick ? std::vector<double>{1e-2} : std::vector<double>{1e-2, 1e-3, 1e-5, 1e-7};
-    for (double w : weights) {
+    for (double w : {1e-2, 1e-3, 1e-5, 1e-7}) {
         // Below the default cut-off an amplifying scene's tree (ks + kt > 1)
         // no longer shrinks with depth: 2^64 rays. Its sweep stops there.
         if (scene.anyAmplifying() && w < kDefaultSettings.minWeight) continue;
@@ -53,11 +61,6 @@ std::vector<Setting> settingsFor(const Scene& scene, bool quick, bool fp64) {
         Setting flip{autoUsesBvh ? "BVH off" : "BVH on"};
         flip.bvh = autoUsesBvh ? gpu::BvhMode::Off : gpu::BvhMode::On;
         s.push_back(flip);
-    }
-    if (scene.supersample > 1) {
-        Setting one{"spp 1"};
-        one.supersample = 1;
-        s.push_back(one);
     }
     return s;
 }
@@ -159,8 +162,10 @@ constexpr double kFixedTimeRatio = 4.0;
 constexpr double kFixedRayLimit = 50e6;
 constexpr double kFixedRayRatio = 4.0;
 
-constexpr int kLastCutOff = 12, kLastCutOffQuick = 6;  // cut-offs 4^-1 .. 4^-k
-constexpr int kLastDepth = 16, kLastDepthQuick = 5;     // depth caps 1 .. d
+// A quick run's few share their kernels: a cut-off 4^-k and the depth cap k
+// often need the same ray stack (gpu/KernelPolicy.cpp, rayStackEntries).
+constexpr int kLastCutOff = 12, kLastCutOffQuick = 2;  // cut-offs 4^-1 .. 4^-k
+constexpr int kLastDepth = 16, kLastDepthQuick = 2;     // depth caps 1 .. d
 
 // Whether `s` is one of the fixed trees the default is priced against:
 // a cut-off 4^-k at the default depth limit, or a depth cap without a
@@ -226,7 +231,7 @@ void sweepSeries(SceneRun& run, std::vector<Result>& results, std::size_t def, N
 
 // The fixed trees the default is priced against (isFixedTree): (a) weight
 // cut-offs 4^-k at the default depth limit and tree budget, k = 1..12
-// (quick: 1..6), and (b) depth caps d = 1..16 (quick: 1..5) without a
+// (quick: 1..2), and (b) depth caps d = 1..16 (quick: 1..2) without a
 // cut-off. `def` is the index of the scene's default result, its first; the
 // named settings that are fixed trees (depth caps) count without a cost
 // limit, as they are measured anyway. Returns the indices of the trees
