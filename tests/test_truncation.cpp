@@ -14,6 +14,7 @@
 
 #include "reference/CpuRenderer.h"
 #include "render/Truncation.h"
+#include "render/TruncationMessages.h"
 #include "scene/Parser.h"
 
 namespace fs = std::filesystem;
@@ -287,5 +288,52 @@ std::string testName(const testing::TestParamInfo<std::string>& info) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Scenes, BoundHolds, testing::ValuesIn(sceneFiles()), testName);
+
+// The messages' advice: quoted options that keep a tolerance wherever they
+// name --depth or --min-weight (either alone asks for a fixed tree), and
+// never a lower --min-weight than 0.
+std::vector<std::string> quotedAdvice(const std::vector<std::string>& lines) {
+    std::vector<std::string> out;
+    for (const std::string& line : lines)
+        for (auto open = line.find("'--"); open != std::string::npos; open = line.find("'--", open + 1)) {
+            const auto close = line.find('\'', open + 1);
+            out.push_back(line.substr(open + 1, close - open - 1));
+            open = close;
+        }
+    return out;
+}
+
+TEST(TruncationMessages, AdviceKeepsTheTolerance) {
+    snell::TruncationReport report;
+    snell::PixelTruncation unbounded;
+    unbounded.unbounded = unbounded.overTolerance = unbounded.overBudget = true;
+    report.add(unbounded);
+    snell::PixelTruncation estimated;
+    estimated.unbounded = estimated.estimated = true;
+    estimated.estimatedError = 0.001;
+    report.add(estimated);
+    report.deepest = 5;
+    snell::TraceSettings fixed = snell::kDefaultSettings;
+    fixed.tolerance = 0.0;
+    fixed.minWeight = 0.0;
+    for (const snell::TraceSettings& s : {snell::kDefaultSettings, snell::kReferenceSettings, fixed}) {
+        const std::vector<std::string> lines = snell::truncationMessages(report, s);
+        ASSERT_FALSE(lines.empty());
+        for (const std::string& line : lines) {
+            EXPECT_TRUE(line.rfind("snell: warning: ", 0) == 0 || line.rfind("snell: note: ", 0) == 0) << line;
+            EXPECT_EQ(line.find("lower --min-weight"), std::string::npos) << line;
+        }
+        for (const std::string& advice : quotedAdvice(lines)) {
+            const bool namesTree = advice.find("--depth") != std::string::npos ||
+                                   advice.find("--min-weight") != std::string::npos;
+            EXPECT_TRUE(!namesTree || s.tolerance == 0.0 || advice.find("--tolerance") != std::string::npos) << advice;
+            EXPECT_EQ(advice.find("--min-weight 0 "), std::string::npos) << advice;
+        }
+    }
+    // The fixed tree's: a tolerance; the estimated pixels a note only where a tolerance was asked for.
+    const std::vector<std::string> lines = snell::truncationMessages(report, fixed);
+    EXPECT_NE(lines[0].find("'--tolerance 0.00196078'"), std::string::npos) << lines[0];
+    EXPECT_EQ(snell::truncationMessages(report, snell::kDefaultSettings)[0].rfind("snell: note: 1 pixel(s)", 0), 0u);
+}
 
 }  // namespace

@@ -22,6 +22,7 @@
 #include "image/BackgroundWriter.h"
 #include "image/ImageIO.h"
 #include "reference/CpuRenderer.h"
+#include "render/TruncationMessages.h"
 #include "scene/Parser.h"
 #include "vulkan/VulkanContext.h"
 
@@ -51,41 +52,6 @@ struct RenderOptions {
     bool verbose = false;
     bool countLanes = false;
 };
-
-// Where the render may still differ from the exact image (SPEC §4 limit):
-// pixels whose dropped light has no finite bound, or whose tree was stopped.
-void printTruncationWarnings(const TruncationReport& t, const TraceSettings& settings) {
-    // ", e.g. (x, y), ...", or nothing where the renderer kept no coordinates
-    // (the GPU counts its over-budget pixels only).
-    auto examples = [](const std::vector<std::array<int, 2>>& pixels, std::uint64_t count) {
-        std::string s;
-        for (const auto& p : pixels)
-            s += (s.empty() ? "" : ", ") + ("(" + std::to_string(p[0]) + ", " + std::to_string(p[1]) + ")");
-        if (s.empty()) return s;
-        if (count > pixels.size()) s += ", ...";
-        return ", e.g. " + s;
-    };
-    if (t.unsettled() > 0)
-        std::cerr << "snell: warning: " << t.unsettled()
-                  << " pixel(s) dropped light of a material with ks + kt >= 1, which need not decay, and their "
-                  << "colour had not settled at the floor cut-off " << settings.minWeight
-                  << ": the image is not certified there (--bound-image shows where); a lower --min-weight "
-                  << "traces them further" << examples(t.unsettledExamples, t.unsettled()) << "\n";
-    if (t.droppedGrowing > 0)
-        std::cerr << "snell: warning: " << t.droppedGrowing << " pixel(s) dropped light trapped in a material "
-                  << "with ks + kt > 1, which may grow, for want of room to keep it for their next step: their "
-                  << "error is not estimated and the image is not certified there (--bound-image shows where); "
-                  << "the CPU reference (--cpu) keeps all of it" << examples(t.droppedGrowingExamples, t.droppedGrowing)
-                  << "\n";
-    if (t.overBudget > 0)
-        std::cerr << "snell: warning: " << t.overBudget << " pixel(s) reached the tree budget of "
-                  << settings.treeBudget << " rays a sample and were stopped (their bound says by how much they "
-                  << "may still move)" << examples(t.overBudgetExamples, t.overBudget) << "\n";
-    if (t.overTolerance > t.unbounded)
-        std::cerr << "snell: warning: " << t.overTolerance << " pixel(s) are above the tolerance "
-                  << settings.tolerance << " at the floor cut-off " << settings.minWeight
-                  << " (largest bound " << t.maxBound << ")\n";
-}
 
 std::string truncationJson(const TruncationReport& t) {
     std::ostringstream j;
@@ -240,7 +206,8 @@ int RenderCommand::run() {
     stream.commit();
     if (!o_.boundImage.empty()) writeBoundImage(request, bound);
 
-    if (!o_.quiet) printTruncationWarnings(truncation_, request.trace);
+    if (!o_.quiet)
+        for (const std::string& line : truncationMessages(truncation_, request.trace)) std::cerr << line << "\n";
     if (o_.verbose)
         printVerbose(output, request, outcome, o_.cpu ? "CPU reference" : o_.device.precision, parseMs,
                      {stream.encodeMs(), stream.blockedMs(), stream.beside()}, msSince(totalStart), o_.countLanes);
