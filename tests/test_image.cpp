@@ -2,6 +2,7 @@
 // error metrics.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -12,6 +13,7 @@
 
 #include <unistd.h>
 
+#include "image/BoundImage.h"
 #include "image/ImageIO.h"
 #include "metrics/ImageMetrics.h"
 #include <zlib.h>
@@ -422,6 +424,64 @@ TEST_F(ImageFiles, PngTextChunks) {
     const std::string bytes = slurp(path("t.png"));
     EXPECT_NE(bytes.find(std::string("tEXtTitle\0showcase", 18)), std::string::npos);
     EXPECT_NE(bytes.find(std::string("tEXtComment\0size 2", 18)), std::string::npos);
+}
+
+// Grey files (a quantity per pixel) keep one channel, exactly, sign and all,
+// and read back as R = G = B; the text of PNG and EXR files reads back.
+TEST_F(ImageFiles, GreyFilesAndTextReadBack) {
+    Image image(2, 1);
+    image.rgb = {0.25f, 9.0f, 9.0f, -0.0f, 9.0f, 9.0f};
+    const snell::ImageText text{{"Content", "a test"}, {"Region", "1 2 of 8x8"}};
+    for (const char* name : {"g.pfm", "g.exr"}) {
+        snell::writeImage(path(name), image, text, {}, snell::kDefaultExrCompression, snell::ImageLayout::Grey);
+        snell::ImageHeader header;
+        const Image back = snell::readImage(path(name), &header);
+        EXPECT_EQ(header.channels, 1) << name;
+        EXPECT_EQ(back.rgb[0], 0.25f) << name;
+        EXPECT_EQ(back.rgb[2], 0.25f) << name;
+        EXPECT_TRUE(std::signbit(back.rgb[3]) && back.rgb[5] == 0.0f) << name;
+    }
+    EXPECT_EQ(slurp(path("g.pfm")).substr(0, 3), "Pf\n");
+    snell::writeImage(path("t.png"), image, text);
+    for (const char* name : {"t.png", "g.exr"}) {
+        snell::ImageHeader header;
+        snell::readImage(path(name), &header);
+        EXPECT_NE(std::find(header.text.begin(), header.text.end(), text[1]), header.text.end()) << name;
+    }
+}
+
+// A bound image keeps bounds and marks estimates by their sign; compare's
+// reader refuses what is not one, by name.
+TEST_F(ImageFiles, BoundImageRoundTripAndRefusals) {
+    const float none = std::numeric_limits<float>::infinity();
+    for (const char* name : {"b.pfm", "b.exr"}) {
+        snell::writeBoundImage(path(name), 3, 1, {0.001f, 0.5f, 0.7f}, {none, 0.002f, none}, {},
+                               snell::kDefaultExrCompression);
+        const snell::BoundImage b = snell::readBoundImage(path(name));
+        ASSERT_EQ(b.values.size(), 3u) << name;
+        EXPECT_EQ(b.values[0], 0.001f) << name;
+        EXPECT_TRUE(snell::isEstimate(b.values[1]) && b.values[1] == -0.002f) << name;
+        EXPECT_EQ(b.values[2], 0.7f) << name;
+        EXPECT_TRUE(b.note.empty()) << name;
+    }
+    snell::writeBoundImage(path("b.png"), 3, 1, {0.0f, 0.5f, 0.7f}, {}, {}, snell::kDefaultExrCompression);
+    EXPECT_THROW(snell::readBoundImage(path("b.png")), ImageIOError);
+    snell::writeImage(path("colour.pfm"), byteImage());
+    EXPECT_THROW(snell::readBoundImage(path("colour.pfm")), ImageIOError);
+    Image grey(2, 1);
+    grey.rgb = {0.1f, 0.1f, 0.1f, 0.2f, 0.2f, 0.2f};
+    snell::writeImage(path("render.exr"), grey, {{"Source", "scenes/x.scn"}});
+    try {
+        snell::readBoundImage(path("render.exr"));
+        ADD_FAILURE() << "a render read as a bound image";
+    } catch (const ImageIOError& e) {
+        EXPECT_NE(std::string(e.what()).find("render.exr' is a render of 'scenes/x.scn'"), std::string::npos) << e.what();
+    }
+    // An earlier snell's: RGB, equal channels, no scene named.
+    snell::writeImage(path("old.pfm"), grey);
+    const snell::BoundImage old = snell::readBoundImage(path("old.pfm"));
+    EXPECT_EQ(old.values, (std::vector<float>{0.1f, 0.2f}));
+    EXPECT_FALSE(old.note.empty());
 }
 
 }  // namespace

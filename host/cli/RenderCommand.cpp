@@ -20,6 +20,7 @@
 #include "common/Json.h"
 #include "gpu/ComputeRenderer.h"
 #include "image/BackgroundWriter.h"
+#include "image/BoundImage.h"
 #include "image/ImageIO.h"
 #include "reference/CpuRenderer.h"
 #include "render/TruncationMessages.h"
@@ -115,7 +116,8 @@ private:
     // cost, and whether its tiles interleave.
     void estimateGpuCost(const Scene& scene, RenderRequest& request, ComputeRenderer& renderer, Progress& progress,
                          RenderOutcome& r, CostMap& expectedCost) const;
-    void writeBoundImage(const RenderRequest& request, const std::vector<float>& bound) const;
+    void writeBoundImage(const RenderRequest& request, const std::vector<float>& bound,
+                         const std::vector<float>& estimate) const;
     std::string statsJson(const Scene& scene, const RenderRequest& request, const RenderOutcome& r,
                           const std::string& output, double parseMs, const OutputStream& stream, double totalMs) const;
 
@@ -154,8 +156,9 @@ CLI::App* RenderCommand::define(CLI::App& app) {
                 "Trace even when the settings allow a ray tree of astronomical size (no tree budget, and "
                 "amplifying materials or no cut-off): the render may never end");
     c->add_option("--bound-image", o_.boundImage,
-                  "Also write each pixel's truncation bound (how far it may be from the exact image) to FILE "
-                  "(.pfm or .exr keep it unclamped)")
+                  "Also write each pixel's truncation bound (how far it may be from the exact image) to FILE, for "
+                  "compare --bound-image: a certified bound, or where a pixel has none (ks + kt >= 1) but its error "
+                  "was estimated, minus that estimate (.pfm or .exr keep it exact; .png shows magnitudes)")
         ->check(kImageFormat);
     addEncodingOptions(*c, o_.encoding);
     c->add_option("--region", o_.region,
@@ -191,8 +194,11 @@ int RenderCommand::run() {
     checkWritable(output);
     if (!o_.boundImage.empty()) checkWritable(o_.boundImage);
     request.truncation = &truncation_;
-    std::vector<float> bound;
-    if (!o_.boundImage.empty()) request.boundImage = &bound;
+    std::vector<float> bound, estimate;
+    if (!o_.boundImage.empty()) {
+        request.boundImage = &bound;
+        request.estimateImage = &estimate;
+    }
     request.cancel = interruptFlag();
     Progress progress(!o_.quiet);
     request.progress = progress.callback();
@@ -204,7 +210,7 @@ int RenderCommand::run() {
     progress.done();
     if (interrupted()) throw Interrupted("no image written");
     stream.commit();
-    if (!o_.boundImage.empty()) writeBoundImage(request, bound);
+    if (!o_.boundImage.empty()) writeBoundImage(request, bound, estimate);
 
     if (!o_.quiet)
         for (const std::string& line : truncationMessages(truncation_, request.trace)) std::cerr << line << "\n";
@@ -390,13 +396,11 @@ RenderOutcome RenderCommand::renderOnGpu(const Scene& scene, RenderRequest& requ
     }
 }
 
-void RenderCommand::writeBoundImage(const RenderRequest& request, const std::vector<float>& bound) const {
-    // The bound as a grey image: float formats keep it as is.
+void RenderCommand::writeBoundImage(const RenderRequest& request, const std::vector<float>& bound,
+                                    const std::vector<float>& estimate) const {
     const PixelWindow area = request.area();
-    Image image(area.width(), area.height());
-    for (std::size_t i = 0; i < bound.size(); ++i)
-        image.rgb[3 * i] = image.rgb[3 * i + 1] = image.rgb[3 * i + 2] = bound[i];
-    writeImage(o_.boundImage, image, {}, {}, o_.encoding.exr());
+    snell::writeBoundImage(o_.boundImage, area.width(), area.height(), bound, estimate,
+                           {area.x0, area.y0, request.width, request.height}, o_.encoding.exr());
 }
 
 std::string RenderCommand::statsJson(const Scene& scene, const RenderRequest& request, const RenderOutcome& r,

@@ -100,7 +100,7 @@ GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool count
         result.pipelineMs = msSince(pipelineStart);
 
         const PixelWindow& area = plan.area;
-        if (request.boundImage) request.boundImage->assign(std::size_t(area.width()) * area.height(), 0.0f);
+        request.startTruncationImages(std::size_t(area.width()) * area.height());
         if (request.rayImage) request.rayImage->assign(std::size_t(area.width()) * area.height(), 0.0f);
         if (!request.rowSink) result.image = Image(area.width(), area.height());
         // Streaming rows: a band at a time (TilePlan::bandRows).

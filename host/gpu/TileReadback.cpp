@@ -19,7 +19,7 @@ PixelTruncation truncationOf(const OutputPixel& out, int imageX, int imageY) {
     pixel.overBudget = out.truncation.y != 0.0f;
     pixel.overTolerance = out.truncation.z != 0.0f;
     pixel.estimated = out.truncation.x >= 0.0f;
-    pixel.estimatedError = std::max(0.0f, out.truncation.x);
+    if (pixel.estimated) pixel.estimatedError = out.truncation.x;  // the kernel reports no other estimate
     pixel.droppedGrowing = out.truncation.z == 2.0f;
     return pixel;
 }
@@ -44,8 +44,7 @@ void readBackTile(const OutputPixel* pixels, const RenderRequest& request, const
             row[column * 3 + 2] = out.colour.b;
             const PixelTruncation pixel = truncationOf(out, imageX, imageY);
             truncation.add(pixel);
-            if (request.boundImage)
-                (*request.boundImage)[std::size_t(windowRow) * area.width() + column] = pixel.bound;
+            request.recordTruncation(std::size_t(windowRow) * area.width() + column, pixel);
             if (request.rayImage)
                 (*request.rayImage)[std::size_t(windowRow) * area.width() + column] = out.truncation.w;
         }

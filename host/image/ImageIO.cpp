@@ -29,6 +29,8 @@
 #define STBI_ONLY_PNG
 #include <stb/stb_image.h>
 
+#include "image/PngText.h"
+
 namespace snell {
 namespace fs = std::filesystem;
 
@@ -66,20 +68,26 @@ private:
 };
 
 // PFM: rows are stored bottom to top, so each row goes to its own offset.
+// A grey one ("Pf") keeps the first channel of each pixel.
 class PfmWriter : public ImageWriter {
 public:
-    PfmWriter(std::string path, int width, int height) : ImageWriter(std::move(path), width, height) {
-        const std::string header = "PF\n" + std::to_string(width) + " " + std::to_string(height) + "\n-1.0\n";
+    PfmWriter(std::string path, int width, int height, ImageLayout layout)
+        : ImageWriter(std::move(path), width, height), channels_(layout == ImageLayout::Grey ? 1 : 3) {
+        const std::string header = std::string(channels_ == 1 ? "Pf" : "PF") + "\n" + std::to_string(width) + " " +
+                                   std::to_string(height) + "\n-1.0\n";
         headerBytes_ = static_cast<long>(header.size());
         if (std::fwrite(header.data(), 1, header.size(), file_) != header.size())
             throw ImageIOError("cannot write '" + path_ + "': " + errorText());
+        if (channels_ == 1) grey_.resize(std::size_t(width));
     }
     void writeRows(const float* rgb, int rows) override {
-        const long rowBytes = long(width_) * 3 * long(sizeof(float));
+        const long rowBytes = long(width_) * channels_ * long(sizeof(float));
         for (int r = 0; r < rows; ++r, rgb += std::size_t(width_) * 3) {
             const long y = rowsWritten_ + r;
+            for (std::size_t x = 0; x < grey_.size(); ++x) grey_[x] = rgb[3 * x];
+            const float* row = channels_ == 1 ? grey_.data() : rgb;
             if (std::fseek(file_, headerBytes_ + (height_ - 1 - y) * rowBytes, SEEK_SET) != 0 ||
-                std::fwrite(rgb, 1, std::size_t(rowBytes), file_) != std::size_t(rowBytes))
+                std::fwrite(row, 1, std::size_t(rowBytes), file_) != std::size_t(rowBytes))
                 throw ImageIOError("cannot write '" + path_ + "': " + errorText());
         }
         rowsWritten_ += rows;
@@ -88,6 +96,8 @@ public:
 private:
     void finish() override {}
     long headerBytes_ = 0;
+    int channels_;
+    std::vector<float> grey_;
 };
 
 // OpenEXR's output stream over the writer's temporary file.
@@ -126,22 +136,23 @@ Imf::Compression exrLibraryCompression(ExrCompression compression) {
     return Imf::RLE_COMPRESSION;
 }
 
-// OpenEXR, 32-bit float R, G, B, scan lines written as rows come, compressed
-// as asked (ExrCompression) on OpenEXR's thread pool. A piece of a larger
-// image has that image as its display window and its own pixels as the data
-// window; text goes into string attributes.
+// OpenEXR, 32-bit float R, G, B (or Y alone, grey), scan lines written as rows
+// come, compressed as asked (ExrCompression) on OpenEXR's thread pool. A piece
+// of a larger image has that image as its display window and its own pixels as
+// the data window; text goes into string attributes.
 class ExrWriter : public ImageWriter {
 public:
     ExrWriter(std::string path, int width, int height, const ImageText& text, const ImagePlacement& placement,
-              ExrCompression compression)
-        : ImageWriter(std::move(path), width, height), stream_(file_, path_) {
+              ExrCompression compression, ImageLayout layout)
+        : ImageWriter(std::move(path), width, height), stream_(file_, path_),
+          channels_(layout == ImageLayout::Grey ? "Y" : "RGB") {
         const int fullWidth = placement.fullWidth > 0 ? placement.fullWidth : width;
         const int fullHeight = placement.fullHeight > 0 ? placement.fullHeight : height;
         origin_ = Imath::V2i(placement.x, placement.y);
         Imf::Header header(Imath::Box2i(Imath::V2i(0, 0), Imath::V2i(fullWidth - 1, fullHeight - 1)),
                            Imath::Box2i(origin_, origin_ + Imath::V2i(width - 1, height - 1)));
         header.compression() = exrLibraryCompression(compression);
-        for (const char* channel : {"R", "G", "B"}) header.channels().insert(channel, Imf::Channel(Imf::FLOAT));
+        for (char channel : channels_) header.channels().insert(std::string(1, channel), Imf::Channel(Imf::FLOAT));
         for (const auto& [key, value] : text) header.insert(key, Imf::StringAttribute(value));
         startExrThreads();
         // Two line buffers per thread keep every thread fed (OpenEXR's rule).
@@ -152,9 +163,9 @@ public:
             Imf::FrameBuffer frame;
             const Imath::V2i first = origin_ + Imath::V2i(0, rowsWritten_);
             const std::size_t pixelBytes = 3 * sizeof(float);
-            for (int c = 0; c < 3; ++c)
-                frame.insert(std::string(1, "RGB"[c]), Imf::Slice::Make(Imf::FLOAT, rgb + c, first, width_, rows,
-                                                                        pixelBytes, pixelBytes * width_));
+            for (std::size_t c = 0; c < channels_.size(); ++c)
+                frame.insert(std::string(1, channels_[c]), Imf::Slice::Make(Imf::FLOAT, rgb + c, first, width_, rows,
+                                                                           pixelBytes, pixelBytes * width_));
             output_->setFrameBuffer(frame);
             output_->writePixels(rows);
         });
@@ -180,6 +191,7 @@ private:
     ExrFileStream stream_;
     std::unique_ptr<Imf::OutputFile> output_;
     Imath::V2i origin_;
+    std::string channels_;  // their names, one letter each
 };
 
 // PNG: libpng writes the container (signature, header, the text chunks that
@@ -412,12 +424,13 @@ ExrCompression exrCompressionNamed(const std::string& name) {
 
 std::unique_ptr<ImageWriter> ImageWriter::open(const std::string& path, int width, int height,
                                                const ImageText& text, const ImagePlacement& placement,
-                                               ExrCompression compression) {
+                                               ExrCompression compression, ImageLayout layout) {
     switch (formatForPath(path)) {
     case ImageFormat::Png: return std::unique_ptr<ImageWriter>(new PngWriter(path, width, height, text));
     case ImageFormat::Ppm: return std::unique_ptr<ImageWriter>(new PpmWriter(path, width, height));
-    case ImageFormat::Pfm: return std::unique_ptr<ImageWriter>(new PfmWriter(path, width, height));
-    case ImageFormat::Exr: return std::unique_ptr<ImageWriter>(new ExrWriter(path, width, height, text, placement, compression));
+    case ImageFormat::Pfm: return std::unique_ptr<ImageWriter>(new PfmWriter(path, width, height, layout));
+    case ImageFormat::Exr:
+        return std::unique_ptr<ImageWriter>(new ExrWriter(path, width, height, text, placement, compression, layout));
     }
     throw ImageIOError("unknown image format");
 }
@@ -442,73 +455,111 @@ void ImageWriter::commit() {
 }
 
 void writeImage(const std::string& path, const Image& image, const ImageText& text, const ImagePlacement& placement,
-                ExrCompression compression) {
-    auto writer = ImageWriter::open(path, image.width, image.height, text, placement, compression);
+                ExrCompression compression, ImageLayout layout) {
+    auto writer = ImageWriter::open(path, image.width, image.height, text, placement, compression, layout);
     writer->writeRows(image.rgb.data(), image.height);
     writer->commit();
 }
 
-Image readImage(const std::string& path, ImagePlacement* placement) {
-    if (formatForPath(path) == ImageFormat::Exr) {
-        try {
-            Imf::InputFile file(path.c_str());
-            const Imath::Box2i data = file.header().dataWindow();
-            const Imath::Box2i display = file.header().displayWindow();
-            Image image(data.max.x - data.min.x + 1, data.max.y - data.min.y + 1);
-            Imf::FrameBuffer frame;
-            const std::size_t pixelBytes = 3 * sizeof(float);
-            for (int c = 0; c < 3; ++c)  // a missing channel reads as 0
-                frame.insert(std::string(1, "RGB"[c]),
-                             Imf::Slice::Make(Imf::FLOAT, image.rgb.data() + c, data, pixelBytes,
-                                              pixelBytes * std::size_t(image.width)));
-            file.setFrameBuffer(frame);
-            file.readPixels(data.min.y, data.max.y);
-            if (placement)
-                *placement = {data.min.x - display.min.x, data.min.y - display.min.y,
-                              display.max.x - display.min.x + 1, display.max.y - display.min.y + 1, true};
-            return image;
-        } catch (const std::exception& e) {
-            throw ImageIOError("cannot read EXR '" + path + "': " + e.what());
-        }
-    }
-    if (placement) *placement = {};
-    std::ifstream in(path, std::ios::binary);
-    if (!in) throw ImageIOError("cannot open '" + path + "': " + errorText());
-    std::ostringstream buffer;
-    buffer << in.rdbuf();
-    const std::string data = buffer.str();
-    const ImageFormat format = formatForPath(path);
-    if (format == ImageFormat::Png) {
-        int w, h, channels;
-        unsigned char* pixels = stbi_load_from_memory(reinterpret_cast<const stbi_uc*>(data.data()),
-                                                      static_cast<int>(data.size()), &w, &h, &channels, 3);
-        if (!pixels) throw ImageIOError("cannot decode PNG '" + path + "': " + stbi_failure_reason());
-        Image image(w, h);
-        for (std::size_t i = 0; i < image.rgb.size(); ++i) image.rgb[i] = pixels[i] / 255.0f;
-        stbi_image_free(pixels);
+namespace {
+
+// EXR: the data window's pixels, R, G and B (a missing one reads as 0), or Y
+// alone as grey; the windows and string attributes into `header`.
+Image readExr(const std::string& path, ImageHeader& header) {
+    try {
+        Imf::InputFile file(path.c_str());
+        const Imf::Header& h = file.header();
+        const Imath::Box2i data = h.dataWindow();
+        const Imath::Box2i display = h.displayWindow();
+        Image image(data.max.x - data.min.x + 1, data.max.y - data.min.y + 1);
+        const bool grey = h.channels().findChannel("Y") && !h.channels().findChannel("R") &&
+                          !h.channels().findChannel("G") && !h.channels().findChannel("B");
+        Imf::FrameBuffer frame;
+        const std::size_t pixelBytes = 3 * sizeof(float);
+        for (int c = 0; c < (grey ? 1 : 3); ++c)
+            frame.insert(grey ? std::string("Y") : std::string(1, "RGB"[c]),
+                         Imf::Slice::Make(Imf::FLOAT, image.rgb.data() + c, data, pixelBytes,
+                                          pixelBytes * std::size_t(image.width)));
+        file.setFrameBuffer(frame);
+        file.readPixels(data.min.y, data.max.y);
+        if (grey)
+            for (std::size_t i = 0; i < image.rgb.size(); i += 3) image.rgb[i + 1] = image.rgb[i + 2] = image.rgb[i];
+        header.channels = grey ? 1 : 3;
+        header.placement = {data.min.x - display.min.x, data.min.y - display.min.y, display.max.x - display.min.x + 1,
+                            display.max.y - display.min.y + 1, true};
+        for (auto a = h.begin(); a != h.end(); ++a)
+            if (const auto* text = dynamic_cast<const Imf::StringAttribute*>(&a.attribute()))
+                header.text.push_back({a.name(), text->value()});
         return image;
+    } catch (const std::exception& e) {
+        throw ImageIOError("cannot read EXR '" + path + "': " + e.what());
     }
-    std::istringstream header(data);
+}
+
+// P6 PPM, or PFM: colour ("PF") or grey ("Pf", read as R = G = B).
+Image readNetpbm(const std::string& path, const std::string& data, ImageHeader& header) {
+    std::istringstream in(data);
     std::string magic;
     int w = 0, h = 0;
     double scale = 0;
-    header >> magic >> w >> h >> scale;
-    if (!header || w <= 0 || h <= 0 || (magic != "P6" && magic != "PF"))
-        throw ImageIOError("'" + path + "' is not a P6 PPM or colour PFM file");
-    const std::size_t offset = static_cast<std::size_t>(header.tellg()) + 1;
+    in >> magic >> w >> h >> scale;
+    if (!in || w <= 0 || h <= 0 || (magic != "P6" && magic != "PF" && magic != "Pf"))
+        throw ImageIOError("'" + path + "' is not a P6 PPM or PFM file");
+    const std::size_t offset = static_cast<std::size_t>(in.tellg()) + 1;
     Image image(w, h);
     if (magic == "P6") {
         if (scale != 255 || data.size() < offset + image.rgb.size())
             throw ImageIOError("'" + path + "': unsupported or truncated PPM");
         for (std::size_t i = 0; i < image.rgb.size(); ++i)
             image.rgb[i] = static_cast<unsigned char>(data[offset + i]) / 255.0f;
-    } else {
-        if (scale >= 0 || data.size() < offset + image.rgb.size() * sizeof(float))
-            throw ImageIOError("'" + path + "': unsupported (big-endian) or truncated PFM");
-        const std::size_t row = static_cast<std::size_t>(w) * 3;
-        for (int y = 0; y < h; ++y)
-            std::memcpy(image.pixel(0, h - 1 - y), data.data() + offset + y * row * sizeof(float), row * sizeof(float));
+        return image;
     }
+    header.channels = magic == "Pf" ? 1 : 3;
+    const std::size_t row = static_cast<std::size_t>(w) * header.channels;
+    if (scale >= 0 || data.size() < offset + row * h * sizeof(float))
+        throw ImageIOError("'" + path + "': unsupported (big-endian) or truncated PFM");
+    std::vector<float> grey(header.channels == 1 ? row : 0);
+    for (int y = 0; y < h; ++y) {
+        const char* source = data.data() + offset + y * row * sizeof(float);
+        if (header.channels == 3) {
+            std::memcpy(image.pixel(0, h - 1 - y), source, row * sizeof(float));
+            continue;
+        }
+        std::memcpy(grey.data(), source, row * sizeof(float));
+        float* out = image.pixel(0, h - 1 - y);
+        for (int x = 0; x < w; ++x) out[3 * x] = out[3 * x + 1] = out[3 * x + 2] = grey[std::size_t(x)];
+    }
+    return image;
+}
+
+}  // namespace
+
+Image readImage(const std::string& path, ImagePlacement* placement) {
+    ImageHeader header;
+    Image image = readImage(path, &header);
+    if (placement) *placement = header.placement;
+    return image;
+}
+
+Image readImage(const std::string& path, ImageHeader* header) {
+    ImageHeader local;
+    ImageHeader& h = header ? *header : local;
+    h = {};
+    if (formatForPath(path) == ImageFormat::Exr) return readExr(path, h);
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw ImageIOError("cannot open '" + path + "': " + errorText());
+    std::ostringstream buffer;
+    buffer << in.rdbuf();
+    const std::string data = buffer.str();
+    if (formatForPath(path) != ImageFormat::Png) return readNetpbm(path, data, h);
+    int w, h8, channels;
+    unsigned char* pixels = stbi_load_from_memory(reinterpret_cast<const stbi_uc*>(data.data()),
+                                                  static_cast<int>(data.size()), &w, &h8, &channels, 3);
+    if (!pixels) throw ImageIOError("cannot decode PNG '" + path + "': " + stbi_failure_reason());
+    Image image(w, h8);
+    for (std::size_t i = 0; i < image.rgb.size(); ++i) image.rgb[i] = pixels[i] / 255.0f;
+    stbi_image_free(pixels);
+    h.text = pngText(data);
     return image;
 }
 

@@ -63,13 +63,27 @@ const char* exrCompressionName(ExrCompression compression);
 // The compression named `name`; throws ImageIOError for an unknown name.
 ExrCompression exrCompressionNamed(const std::string& name);
 
+// The channels a float file holds: RGB, or one grey channel (a PFM "Pf", an
+// EXR of "Y" alone), for a quantity per pixel rather than a colour (the
+// truncation bound). Rows are given as RGB either way, and a grey file keeps
+// their first channel; PNG and PPM write grey as RGB.
+enum class ImageLayout { Rgb, Grey };
+
+// What a file says of its image beside its pixels.
+struct ImageHeader {
+    ImagePlacement placement;
+    ImageText text;     // PNG tEXt chunks, EXR string attributes
+    int channels = 3;   // 1: a grey file (ImageLayout::Grey), read as R = G = B
+};
+
 // Rows of width × 3 floats, top to bottom, in one or more calls.
 class ImageWriter {
 public:
     // Opens a temporary file beside `path`. Throws ImageIOError.
     static std::unique_ptr<ImageWriter> open(const std::string& path, int width, int height,
                                              const ImageText& text = {}, const ImagePlacement& placement = {},
-                                             ExrCompression compression = kDefaultExrCompression);
+                                             ExrCompression compression = kDefaultExrCompression,
+                                             ImageLayout layout = ImageLayout::Rgb);
     virtual ~ImageWriter();
     // The next `rows` rows (rgb floats, width * 3 per row).
     virtual void writeRows(const float* rgb, int rows) = 0;
@@ -87,8 +101,11 @@ protected:
 };
 
 void writeImage(const std::string& path, const Image& image, const ImageText& text = {},
-                const ImagePlacement& placement = {}, ExrCompression compression = kDefaultExrCompression);
+                const ImagePlacement& placement = {}, ExrCompression compression = kDefaultExrCompression,
+                ImageLayout layout = ImageLayout::Rgb);
 // `placement`, if given, receives where the file says the image lies.
 Image readImage(const std::string& path, ImagePlacement* placement = nullptr);
+// `header` receives all the file says of the image.
+Image readImage(const std::string& path, ImageHeader* header);
 
 }  // namespace snell

@@ -491,6 +491,8 @@ CpuRenderer::Pixel CpuRenderer::renderPixel(const RenderRequest& request, int x,
         // estimated error is within the tolerance.
         if (!continues || within || tree.frontier.empty()) break;
         const double error = change.error();
+        // Kept for the bound image: terms >= 0, so it holds for later, larger colours.
+        pixel.estimatedError = error;
         if (settings.estimate && pixel.unbounded && error <= settings.tolerance &&
             (!tree.amplified || error <= kAmplifiedEstimate)) {
             pixel.estimated = true;
@@ -530,7 +532,7 @@ Image CpuRenderer::render(const RenderRequest& request, RayCounts* counts) const
                             : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
     std::vector<RayCounts> perThread(threads);
     std::vector<TruncationReport> truncation(threads);
-    if (request.boundImage) request.boundImage->assign(static_cast<std::size_t>(width) * height, 0.0f);
+    request.startTruncationImages(static_cast<std::size_t>(width) * height);
     std::atomic<int> rowsDone{0};
     std::atomic<std::uint64_t> raysTraced{0};
     for (int bandStart = 0; bandStart < height; bandStart += bandRows) {
@@ -560,9 +562,7 @@ Image CpuRenderer::render(const RenderRequest& request, RayCounts* counts) const
                     outcome.estimatedError = pixel.estimatedError;
                     t.add(outcome);
                     t.deepest = std::max(t.deepest, pixel.deepest);
-                    if (request.boundImage)
-                        (*request.boundImage)[static_cast<std::size_t>(row) * width + column] =
-                            static_cast<float>(pixel.bound);
+                    request.recordTruncation(static_cast<std::size_t>(row) * width + column, outcome);
                     float* p = target.pixel(column, row - targetOffset);
                     p[0] = static_cast<float>(c.x);
                     p[1] = static_cast<float>(c.y);

@@ -31,7 +31,7 @@ public:
         bool overBudget = false;    // a sample's tree reached TraceSettings::treeBudget
         bool overTolerance = false; // still above the tolerance at the floor cut-off
         bool estimated = false;     // unbounded, and stopped by its estimated error (render/Truncation.h)
-        double estimatedError = 0.0;
+        double estimatedError = std::numeric_limits<double>::infinity();  // the last one made (+inf: none)
         int deepest = 0;            // the deepest ray traced
     };
     Pixel renderPixel(const RenderRequest& request, int x, int y, RayCounts& counts) const;

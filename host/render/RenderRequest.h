@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdint>
 #include <functional>
+#include <limits>
 #include <vector>
 
 #include "render/Truncation.h"
@@ -160,6 +161,19 @@ struct RenderRequest {
     TruncationReport* truncation = nullptr;
     // When set, each pixel's truncation bound, row-major (width * height).
     std::vector<float>* boundImage = nullptr;
+    // When set, each pixel's estimated error where it has no finite bound and
+    // one was made (PixelTruncation::estimatedError), else +inf, row-major.
+    std::vector<float>* estimateImage = nullptr;
+    // The renderers' part in the two: sized for `pixels`, then pixel `at`.
+    void startTruncationImages(std::size_t pixels) const {
+        if (boundImage) boundImage->assign(pixels, 0.0f);
+        if (estimateImage) estimateImage->assign(pixels, std::numeric_limits<float>::infinity());
+    }
+    void recordTruncation(std::size_t at, const PixelTruncation& p) const {
+        if (boundImage) (*boundImage)[at] = float(p.bound);
+        if (estimateImage)
+            (*estimateImage)[at] = p.unbounded ? float(p.estimatedError) : std::numeric_limits<float>::infinity();
+    }
     // When set (GPU renderer), each pixel's rays (closest-hit queries of its
     // trees), row-major (width * height): its cost.
     std::vector<float>* rayImage = nullptr;

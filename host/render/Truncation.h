@@ -127,7 +127,9 @@ struct PixelTruncation {
     bool overBudget = false;      // stopped by the tree budget, not finished
     bool overTolerance = false;   // still above the tolerance at the floor cut-off
     bool estimated = false;       // unbounded, stopped by its estimated error (ErrorEstimate)
-    double estimatedError = 0.0;
+    // Where unbounded, the last estimate of its error made (+inf: none),
+    // within the tolerance or not; the GPU reports those it stopped on only.
+    double estimatedError = std::numeric_limits<double>::infinity();
     bool droppedGrowing = false;  // dropped light that may grow for want of room (the GPU's frontier or stack)
 };
 
