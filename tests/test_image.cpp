@@ -484,4 +484,29 @@ TEST_F(ImageFiles, BoundImageRoundTripAndRefusals) {
     EXPECT_FALSE(old.note.empty());
 }
 
+// With a bound image: certified pixels compared as without one, estimated ones
+// held to their estimate (bad beyond it, counted), others left out unless the
+// bound proves them wrong; comparing nothing has no PSNR.
+TEST(Metrics, HeldToEstimatesAndBounds) {
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    const Image reference = fromBytes(6, 1, {100, 100, 100, 100, 100, 100, 100, 100, 100, 100, 100, 100, 100, 100,
+                                             100, 100, 100, 100});
+    const Image test = fromBytes(6, 1, {104, 100, 100, 102, 100, 100, 106, 100, 100, 104, 100, 100, 106, 100, 100,
+                                        110, 100, 100});
+    snell::BoundImage bound{6, 1, {0.0f, -0.3f / 255, -1.5f / 255, 1.9f / 255, 1.9f / 255, nan}, {}};
+    const snell::ImageMetrics m = snell::compareImages(test, reference, 3, &bound);
+    // 0: certified, off by 4: bad. 1: estimate 0.3/255, off by 2: fine.
+    // 2: estimate 1.5/255 (2 steps), off by 6: bad. 3: bound 1.9/255, off by 4:
+    // left out. 4: off by 6 > 2 + 3: proven wrong. 5: NaN bound: left out.
+    EXPECT_EQ(m.pixels, 4u);
+    EXPECT_EQ(m.uncertain, 2u);
+    EXPECT_EQ(m.estimated, 2u);
+    EXPECT_EQ(m.estimatedBad, 1u);
+    EXPECT_EQ(m.badPixels, 3u);
+    snell::BoundImage unknown{6, 1, std::vector<float>(6, 1.0f), {}};
+    const snell::ImageMetrics none = snell::compareImages(reference, reference, 3, &unknown);
+    EXPECT_EQ(none.pixels, 0u);
+    EXPECT_TRUE(std::isnan(none.psnr));
+}
+
 }  // namespace

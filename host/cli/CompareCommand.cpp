@@ -1,13 +1,15 @@
 // `snell compare`: error metrics of a test image against a reference, and a
 // verdict for scripts and graders. Exit status as cmp(1)'s: 0 the images
-// agree within the thresholds, 1 they do not, 2 trouble (an image that
-// cannot be read or written, sizes that differ).
+// agree within the thresholds, 1 they do not (or no pixel could be compared),
+// 2 trouble (an image that cannot be read or written, sizes that differ, a
+// --bound-image that is not one).
 #include <cstdio>
 #include <iostream>
 
 #include "cli/Command.h"
 #include "cli/ExitStatus.h"
 #include "cli/Options.h"
+#include "image/BoundImage.h"
 #include "image/ImageIO.h"
 #include "metrics/ImageMetrics.h"
 
@@ -29,7 +31,7 @@ public:
         CLI::App* c = app.add_subcommand(
             "compare",
             "Compare image A with reference B (8-bit units): metrics, and exit status 0 if they agree within the "
-            "thresholds, 1 if not, 2 on trouble");
+            "thresholds, 1 if not (or no pixel could be compared), 2 on trouble");
         c->add_option("a", a_, "Test image")->required();
         c->add_option("b", b_, "Reference image")->required();
         c->add_option("--diff", diff_, "Write a false-colour difference image")->check(kImageFormat);
@@ -40,8 +42,11 @@ public:
         c->add_option("--max-bad", t_.maxBad, "Largest share of bad pixels that agrees, in percent (default 0.1)")
             ->check(number(0.0, 100.0));
         c->add_option("--bound-image", bound_,
-                      "The reference's bound image (render --bound-image, .pfm or .exr): leave out pixels it does not "
-                      "certify, unless the bound proves them wrong")
+                      "The reference's bound image (render --bound-image, .pfm or .exr). It certifies a pixel whose "
+                      "bound is within half an 8-bit step: compared as usual. Where the reference has no finite bound "
+                      "(ks + kt >= 1) but estimated its error, the pixel is held to that estimate: compared, bad "
+                      "beyond it, and counted as estimated. Any other pixel is left out as uncertain, unless its "
+                      "bound proves it wrong. A file that is not a bound image is refused")
             ->check(kExistingFile);
         c->add_option("--max-uncertain", t_.maxUncertain,
                       "Largest share of pixels --bound-image may leave out, in percent; more disagrees (default 1)")
@@ -62,8 +67,9 @@ private:
     int compare() const {
         const Image test = readImage(a_);
         const Image reference = readImage(b_);
-        Image bound;
-        if (!bound_.empty()) bound = readImage(bound_);
+        BoundImage bound;
+        if (!bound_.empty()) bound = readBoundImage(bound_);
+        if (!bound.note.empty()) std::cerr << "snell: warning: " << bound.note << "\n";
         const ImageMetrics m = compareImages(test, reference, t_.badLevel, bound_.empty() ? nullptr : &bound);
         if (!diff_.empty()) writeImage(diff_, differenceImage(test, reference));
         const std::string verdict = judge(m);
@@ -72,19 +78,28 @@ private:
             j.pop_back();
             std::cout << j << ", \"agree\": " << (verdict.empty() ? "true" : "false") << "}" << std::endl;
         } else {
-            std::printf("mean abs error %.4f/255, RMSE %.4f/255, PSNR %.2f dB, max %d/255\n"
-                        "bad pixels (> %d/255) %llu of %llu (%.4f%%), isolated speckles %llu, NaN/Inf %llu\n",
-                        m.meanAbsError, m.rmse, m.psnr, m.maxError, t_.badLevel,
-                        static_cast<unsigned long long>(m.badPixels), static_cast<unsigned long long>(m.pixels),
-                        100.0 * m.badFraction, static_cast<unsigned long long>(m.speckles),
-                        static_cast<unsigned long long>(m.nonFinite));
-            if (!bound_.empty())
-                std::printf("left out %llu uncertain pixel(s) of %llu (the reference's bound cannot decide them)\n",
-                            static_cast<unsigned long long>(m.uncertain),
-                            static_cast<unsigned long long>(m.pixels + m.uncertain));
-            std::printf("%s\n", verdict.empty() ? "agree" : ("differ: " + verdict).c_str());
+            printText(m, verdict);
         }
         return verdict.empty() ? kExitSuccess : kExitDiffer;
+    }
+
+    void printText(const ImageMetrics& m, const std::string& verdict) const {
+        using ull = unsigned long long;
+        if (m.pixels == 0)
+            std::printf("no pixel compared, NaN/Inf %llu\n", ull(m.nonFinite));
+        else
+            std::printf("mean abs error %.4f/255, RMSE %.4f/255, PSNR %.2f dB, max %d/255\n"
+                        "bad pixels (> %d/255) %llu of %llu (%.4f%%), isolated speckles %llu, NaN/Inf %llu\n",
+                        m.meanAbsError, m.rmse, m.psnr, m.maxError, t_.badLevel, ull(m.badPixels), ull(m.pixels),
+                        100.0 * m.badFraction, ull(m.speckles), ull(m.nonFinite));
+        if (!bound_.empty()) {
+            std::printf("held %llu of them to the reference's estimated error, as it has no finite bound there "
+                        "(%llu bad)\n",
+                        ull(m.estimated), ull(m.estimatedBad));
+            std::printf("left out %llu uncertain pixel(s) of %llu (the reference's bound cannot decide them)\n",
+                        ull(m.uncertain), ull(m.pixels + m.uncertain));
+        }
+        std::printf("%s\n", verdict.empty() ? "agree" : ("differ: " + verdict).c_str());
     }
 
     // Why the images do not agree (empty when they do).
@@ -93,6 +108,12 @@ private:
         std::string out;
         auto add = [&out](const char* reason) { out += (out.empty() ? "" : "; ") + std::string(reason); };
         const double all = double(m.pixels + m.uncertain);
+        // Comparing nothing is no agreement.
+        if (m.pixels == 0) {
+            std::snprintf(why, sizeof why, "no pixel compared (%llu left out as uncertain)",
+                          static_cast<unsigned long long>(m.uncertain));
+            add(why);
+        }
         if (m.nonFinite > 0) add("the test image has NaN or infinite values");
         if (m.meanAbsError > t_.maxMean) {
             std::snprintf(why, sizeof why, "mean %.4f/255 > --max-mean %g", m.meanAbsError, t_.maxMean);

@@ -14,21 +14,38 @@ std::string ImageMetrics::json() const {
     std::snprintf(buffer, sizeof buffer,
                   "{\"mean_abs_error\": %.6f, \"rmse\": %.6f, \"psnr\": %s, \"max_error\": %d, "
                   "\"bad_pixels\": %llu, \"bad_fraction\": %.8f, \"non_finite\": %llu, \"speckles\": %llu, "
-                  "\"pixels\": %llu, \"uncertain_pixels\": %llu}",
+                  "\"pixels\": %llu, \"estimated_pixels\": %llu, \"estimated_bad_pixels\": %llu, "
+                  "\"uncertain_pixels\": %llu}",
                   meanAbsError, rmse, std::isfinite(psnr) ? std::to_string(psnr).c_str() : "null", maxError,
                   static_cast<unsigned long long>(badPixels), badFraction,
                   static_cast<unsigned long long>(nonFinite), static_cast<unsigned long long>(speckles),
-                  static_cast<unsigned long long>(pixels), static_cast<unsigned long long>(uncertain));
+                  static_cast<unsigned long long>(pixels), static_cast<unsigned long long>(estimated),
+                  static_cast<unsigned long long>(estimatedBad), static_cast<unsigned long long>(uncertain));
     return buffer;
 }
 
 namespace {
 
-void requireSameSize(const Image& a, const Image& b, const char* what) {
-    if (a.width != b.width || a.height != b.height)
-        throw std::invalid_argument(std::string(what) + " differ in size: " + std::to_string(a.width) + "x" +
-                                    std::to_string(a.height) + " against " + std::to_string(b.width) + "x" +
+void requireSameSize(int width, int height, const Image& b, const char* what) {
+    if (width != b.width || height != b.height)
+        throw std::invalid_argument(std::string(what) + " differ in size: " + std::to_string(width) + "x" +
+                                    std::to_string(height) + " against " + std::to_string(b.width) + "x" +
                                     std::to_string(b.height));
+}
+
+// What the reference's bound image says of a pixel (compareImages).
+enum class Standing { Certified, Estimated, Uncertain };
+struct PixelStanding {
+    Standing standing = Standing::Certified;
+    int allowance = 0;  // 8-bit steps the reference may be off by, beyond the bad threshold
+};
+PixelStanding standing(float value) {
+    // A NaN bound never certifies, nor proves anything wrong.
+    if (std::isnan(value)) return {Standing::Uncertain, 255};
+    const double steps = 255.0 * std::abs(double(value));
+    const int allowance = steps <= 0.5 ? 0 : int(std::ceil(steps));
+    if (isEstimate(value)) return {Standing::Estimated, allowance};
+    return {allowance == 0 ? Standing::Certified : Standing::Uncertain, allowance};
 }
 
 // Pixel p's channel differences in 1/255 units: the largest, their sum and
@@ -70,9 +87,11 @@ std::uint64_t countSpeckles(const std::vector<int>& worstOf, int width, int heig
 
 }  // namespace
 
-ImageMetrics compareImages(const Image& test, const Image& reference, int badThreshold, const Image* referenceBound) {
-    requireSameSize(test, reference, "images");
-    if (referenceBound) requireSameSize(*referenceBound, reference, "the bound image and the reference");
+ImageMetrics compareImages(const Image& test, const Image& reference, int badThreshold,
+                           const BoundImage* referenceBound) {
+    requireSameSize(test.width, test.height, reference, "images");
+    if (referenceBound)
+        requireSameSize(referenceBound->width, referenceBound->height, reference, "the bound image and the reference");
     ImageMetrics m;
     const std::size_t pixels = static_cast<std::size_t>(test.width) * test.height;
     std::vector<int> worstOf(pixels, 0);
@@ -80,29 +99,33 @@ ImageMetrics compareImages(const Image& test, const Image& reference, int badThr
     for (std::size_t p = 0; p < pixels; ++p) {
         const PixelDifference d = difference(test, reference, p);
         m.nonFinite += d.nonFinite;
-        if (referenceBound) {
-            const float* b = &referenceBound->rgb[p * 3];
-            const double bound = 255.0 * std::max({b[0], b[1], b[2]});
-            // A NaN bound never certifies; no bound excuses a NaN pixel.
-            const bool certified = bound <= 0.5;
-            const bool provenWrong = double(d.worst) > std::ceil(bound) + badThreshold || d.nonFinite > 0;
-            if (!certified && !provenWrong) {
-                ++m.uncertain;
-                continue;
-            }
+        const PixelStanding s = referenceBound ? standing(referenceBound->values[p]) : PixelStanding{};
+        // No bound excuses a NaN pixel.
+        const bool provenWrong = d.worst > s.allowance + badThreshold || d.nonFinite > 0;
+        if (s.standing == Standing::Uncertain && !provenWrong) {
+            ++m.uncertain;
+            continue;
         }
         sum += d.sum;
         sumSquares += d.sumSquares;
         worstOf[p] = d.worst;
         m.maxError = std::max(m.maxError, d.worst);
-        if (d.worst > badThreshold) ++m.badPixels;
+        const bool bad = d.worst > badThreshold + (s.standing == Standing::Estimated ? s.allowance : 0);
+        m.badPixels += bad;
+        if (s.standing == Standing::Estimated) {
+            ++m.estimated;
+            m.estimatedBad += bad;
+        }
     }
     m.pixels = pixels - m.uncertain;
     m.speckles = countSpeckles(worstOf, test.width, test.height);
     const double n = m.pixels ? 3.0 * m.pixels : 1.0;
     m.meanAbsError = sum / n;
     m.rmse = std::sqrt(sumSquares / n);
-    m.psnr = m.rmse > 0 ? 20.0 * std::log10(255.0 / m.rmse) : std::numeric_limits<double>::infinity();
+    // Nothing compared has no PSNR: never the perfect score of identical images.
+    m.psnr = m.pixels == 0  ? std::numeric_limits<double>::quiet_NaN()
+             : m.rmse > 0 ? 20.0 * std::log10(255.0 / m.rmse)
+                          : std::numeric_limits<double>::infinity();
     m.badFraction = m.pixels ? double(m.badPixels) / m.pixels : 0.0;
     return m;
 }
