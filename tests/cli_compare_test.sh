@@ -62,7 +62,7 @@ check_advice "default" glass.scn "estimated error was not yet within the toleran
 # A fixed tree's: a tolerance with the same floor estimates them, tracing no
 # more than the fixed tree (glass.scn has no trap: nothing goes below the floor).
 check_advice "fixed tree" glass.scn "a fixed tree .* does not estimate" fewer --min-weight 1e-7
-check_advice "POV-Ray's tree" glass.scn "a fixed tree .* does not estimate" fewer --cpu --depth 5 --min-weight 0
+check_advice "depth 5, no cut-off" glass.scn "a fixed tree .* does not estimate" fewer --cpu --depth 5 --min-weight 0
 # A tolerance capped by --depth: a deeper cap (the CPU reference says the same).
 check_advice "depth cap" glass.scn "reached the depth limit 5" more --cpu --depth 5 --min-weight 0 --tolerance $T
 # Pixels with a finite bound above a tight tolerance at the floor: a lower floor.
