@@ -5,14 +5,8 @@
 # the same warnings, in line order, beside the errors; check --json carries
 # errors and warnings with their positions; a UTF-8 byte-order mark is
 # accepted; a number's error names its argument.
-set -u
-: "${SNELL:?}" "${SCENES:?}"
-work=$(mktemp -d)
-export SNELL_CACHE_DIR="$work/cache"  # the test's own, not the user's
-trap 'rm -rf "$work"' EXIT
-pass=0 fail=0
-ok() { pass=$((pass + 1)); }
-bad() { echo "FAIL: $*"; fail=$((fail + 1)); }
+# shellcheck source=tests/cli_test_support.sh
+source "$(dirname "$0")/cli_test_support.sh"
 
 # Runs a command with 1 GiB of memory at most, so that input read without
 # bound fails here instead of taking the machine: ulimit -v, or, under

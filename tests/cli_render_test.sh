@@ -3,14 +3,8 @@
 # tests/cli_test.sh): signals and a failing GPU leave no file, the stated
 # bound, --region and `snell assemble`, the progress bar, runaway trees, -o -,
 # check, standard input, compare, suggestions, warnings, --count-lanes.
-set -u
-: "${SNELL:?}" "${SCENES:?}"
-work=$(mktemp -d)
-export SNELL_CACHE_DIR="$work/cache"  # the test's own, not the user's
-trap 'rm -rf "$work"' EXIT
-pass=0 fail=0
-ok() { pass=$((pass + 1)); }
-bad() { echo "FAIL: $*"; fail=$((fail + 1)); }
+# shellcheck source=tests/cli_test_support.sh
+source "$(dirname "$0")/cli_test_support.sh"
 # interrupt_after PATTERN ARGS...: `snell render ARGS` with its stderr in
 # $work/err, interrupted once a line matches PATTERN (a warning printed before
 # the render starts) or after 20 s; a second later, to let any warning that

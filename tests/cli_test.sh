@@ -3,14 +3,8 @@
 # format, --help/--version, the kept caches, --stats JSON, every output format,
 # and that a failed render never writes, truncates or clobbers an output file.
 # Rendering's own cases are in tests/cli_render_test.sh.
-set -u
-: "${SNELL:?}" "${SCENES:?}"
-work=$(mktemp -d)
-export SNELL_CACHE_DIR="$work/cache"  # the test's own, not the user's
-trap 'rm -rf "$work"' EXIT
-pass=0 fail=0
-ok() { pass=$((pass + 1)); }
-bad() { echo "FAIL: $*"; fail=$((fail + 1)); }
+# shellcheck source=tests/cli_test_support.sh
+source "$(dirname "$0")/cli_test_support.sh"
 
 # --help and --version
 "$SNELL" --help >"$work/help" 2>&1 && grep -q "render" "$work/help" && grep -q "Exit status" "$work/help" && ok || bad "--help"
