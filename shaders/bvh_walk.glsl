@@ -2,8 +2,10 @@
 // four-wide nodes, shared_layout.h: BvhNode), shared by the renderer
 // (trace.comp) and the walk's floor kernel (bvh_walk_kernel.comp). The
 // includer declares before it: BVH_DEPTH and STACK_IN_REGISTERS (constants),
-// NONE, uvec4 bvhWord(int) (word i of the nodes) and
-// real intersectSphere(index, origin, originLength, dir, fromSphere, start).
+// NONE, uvec4 bvhWord(int) (word i of the nodes),
+// real intersectSphere(index, origin, originLength, dir, fromSphere, start),
+// void offer(t, index, tHit, hit) (a sphere's crossing t: the hit if nearer
+// than tHit) and real cullSlack() (how far past tHit a box still counts).
 #ifndef SNELL_BVH_WALK_GLSL
 #define SNELL_BVH_WALK_GLSL
 
@@ -85,7 +87,7 @@ void walkPass(inout uint entry, inout uint depth, inout bool walking, inout real
         // Ize, "Robust BVH Ray Traversal" (JCGT 2013): the exit distance is
         // widened so rounding never culls a box the ray touches.
         rvec4 enter = max(max(min(x0, x1), min(y0, y1)), max(min(z0, z1), rvec4(0.0)));
-        rvec4 leave = min(min(max(x0, x1), max(y0, y1)), min(max(z0, z1), rvec4(tHit))) * (1.0 + 8.0 * UNIT_ROUNDOFF);
+        rvec4 leave = min(min(max(x0, x1), max(y0, y1)), min(max(z0, z1), rvec4(tHit + cullSlack()))) * (1.0 + 8.0 * UNIT_ROUNDOFF);
         bvec4 enters = bvec4(uvec4(lessThanEqual(enter, leave)) & uvec4(notEqual(child, uvec4(SNELL_BVH_EMPTY))));
         // Children missed sort last, at +inf (an entered box's entry is finite).
         real never = real(uintBitsToFloat(0x7f800000u));
@@ -113,8 +115,7 @@ void walkPass(inout uint entry, inout uint depth, inout bool walking, inout real
         [[unroll]] for (uint k = 0u; k < SNELL_BVH_MAX_LEAF; ++k) {
             uint i = first + k;
             if (i <= last) {
-                real t = intersectSphere(i, origin, originLength, dir, fromSphere, start);
-                if (t < tHit) { tHit = t; hit = i; }
+                offer(intersectSphere(i, origin, originLength, dir, fromSphere, start), i, tHit, hit);
             }
         }
         if ((anyHit && hit != NONE) || depth == 0u) walking = false;

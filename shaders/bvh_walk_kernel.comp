@@ -47,6 +47,14 @@ real intersectSphere(uint index, vec3 origin, float originLength, vec3 dir, uint
                                   dir, mode);
     return intersectTrueSphere(s.anchorRadius, s.normal, origin, originLength, dir, mode);
 }
+// The walk's floor keeps no margins (margins.glsl).
+void offer(real t, uint i, inout real tHit, inout uint hit) {
+    if (t < tHit) {
+        tHit = t;
+        hit = i;
+    }
+}
+real cullSlack() { return 0.0; }
 
 #include "bvh_walk.glsl"
 

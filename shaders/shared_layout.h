@@ -100,7 +100,8 @@ using uint = std::uint32_t;
 #define SNELL_SPEC_SHARE_SHADOW_RAYS 21  // a subgroup's shadow rays walked by all its lanes (schedule/lights.glsl, shadeLightsShared)
 #define SNELL_SPEC_LIGHTS_IN_FRAME 22  // the lights are read from FrameParams.lights
 #define SNELL_SPEC_STACKS_BY_ADDRESS 23  // the ray and media stacks through their addresses (FrameParams.rayStackAddress)
-#define SNELL_SPEC_COUNT 24
+#define SNELL_SPEC_DECISIONS 24  // decisions keep their rounding margins (physics/margins.glsl)
+#define SNELL_SPEC_COUNT 25
 // The deepest walk stack kept in registers (entries); a deeper one is an array
 // at a per-lane index.
 #define SNELL_REGISTER_STACK_LIMIT 32
@@ -235,6 +236,8 @@ struct SlotState {
     vec4 lower;      // rgb: the pixel's best lower and upper bounds over its steps so far
     vec4 upper;      //      (render/Truncation.h, PixelEstimate)
     vec4 settled;    // rgb: its colour after the last step, clamped (render/Truncation.h, ErrorEstimate)
+    vec4 undecided;  // rgb: the weight of its rays whose light undecided decisions may change; a: the light of
+                     // its undecided shadow rays, largest channel (physics/margins.glsl); over its samples
     uint pixel;      // the pixel of the tile in progress (row-major); ≥ tile size: done
     uint started;    // samples of it started
     uint pending;    // rays waiting on this invocation's stack
@@ -253,7 +256,7 @@ struct SlotState {
     float moveBefore;    // and the step before it
     float settledWeight; // the weight the pixel had not traced after the last step, in channels under 1, per sample
     uint droppedGrowing; // 1: light that may grow was dropped for want of room (a full frontier or ray stack)
-    uint pad1;
+    float shading;       // the light shading's rounding may have moved, largest channel, over its samples
     uint pad2;
 };
 
@@ -264,17 +267,21 @@ struct OutputPixel {
                       // y: 1 where the tree budget stopped it; z: 1 where it ended over the tolerance,
                       // 2 where that is because light that may grow was dropped (SlotState::droppedGrowing);
                       // w: the rays (closest-hit queries) its trees traced, its cost (RenderRequest::rayImage)
+    vec4 undecided;   // SlotState::undecided, summed over its samples: its undecided decisions may change
+                      // its colour either way by rgb times R (render/Truncation.h), plus a
+    vec4 shading;     // x: SlotState::shading (physics/shade.glsl, shadingError)
 };
 
 // A ray waiting to be traced (SPEC §4 ray tree, depth first). Its medium stack
 // is kept beside it in the media buffer.
 struct PendingRay {
-    vec4 origin;     // xyz
-    vec4 direction;  // xyz, unit
+    vec4 origin;     // xyz; w: how far it may be from the exact ray's origin (physics/margins.glsl)
+    vec4 direction;  // xyz, unit; w: how far its direction may be turned from the exact ray's
     vec4 weight;     // rgb: product of the ks/kt factors along its path
     uint depth;
     uint fromSphere; // the sphere whose surface it starts on
-    uint flags;      // bit 0: it heads into that sphere; bits 1..: medium-stack size
+    uint flags;      // bit 0: it heads into that sphere; bit 31: an undecided ancestor covers its light;
+                     // bits 1..30: medium-stack size
     uint resumeShading;  // 0: not shaded yet; k > 0: suspended while shading, resumes at light k − 1
 };
 

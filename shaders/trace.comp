@@ -3,6 +3,7 @@
 // one ray; its steps are pure functions in physics/, one concept a file:
 //
 //   camera.glsl    cameraRay       SPEC §3: the ray through a sub-pixel
+//   margins.glsl   offAt, ...      the margins of the decisions rounding can flip
 //   hit.glsl       findHit         SPEC §4.1: the closest hit, brute force,
 //                  occluded          BVH walk (bvh_walk.glsl) or ray query
 //   shade.glsl     ambientTerm,    SPEC §4.3: the local Phong term, binary
@@ -127,6 +128,12 @@ void main() {
         bool shading = false;
         if (hasRay && admitRay(slot, state, ray, cutOff, weight)) {
             shading = findHit(ray, h);
+            // Where rounding may have chosen the hit, the ray's light may be
+            // either answer's: at most its weight times R (margins.glsl).
+            if (DECISIONS && h.undecided && !ray.covered && ray.resumeShading == 0u) {
+                state.undecided.rgb += weight;
+                ray.covered = true;
+            }
             if (!shading) state.sum.rgb += weighted(weight, frame.background.rgb);
             else if (ray.resumeShading == 0u) state.sum.rgb += weighted(weight, ambientTerm(h));
             deepest = max(deepest, ray.depth);

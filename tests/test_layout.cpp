@@ -118,22 +118,24 @@ TEST(Layout, TileParams) {
 }
 
 TEST(Layout, SlotStateAndPendingRay) {
-    EXPECT_EQ(sizeof(gpu::SlotState), 176u);
+    EXPECT_EQ(sizeof(gpu::SlotState), 192u);
     EXPECT_EQ(offsetof(gpu::SlotState, deferred), 16u);
     EXPECT_EQ(offsetof(gpu::SlotState, lower), 48u);
     EXPECT_EQ(offsetof(gpu::SlotState, settled), 80u);
-    EXPECT_EQ(offsetof(gpu::SlotState, pixel), 96u);
-    EXPECT_EQ(offsetof(gpu::SlotState, finished), 108u);
-    EXPECT_EQ(offsetof(gpu::SlotState, treeRays), 112u);
-    EXPECT_EQ(offsetof(gpu::SlotState, frontierHead), 128u);
-    EXPECT_EQ(offsetof(gpu::SlotState, amplified), 140u);
-    EXPECT_EQ(offsetof(gpu::SlotState, cutOff), 144u);
-    EXPECT_EQ(offsetof(gpu::SlotState, heaviestLeft), 148u);
-    EXPECT_EQ(offsetof(gpu::SlotState, lastMove), 152u);
-    EXPECT_EQ(offsetof(gpu::SlotState, moveBefore), 156u);
-    EXPECT_EQ(offsetof(gpu::SlotState, settledWeight), 160u);
-    EXPECT_EQ(sizeof(gpu::OutputPixel), 32u);
+    EXPECT_EQ(offsetof(gpu::SlotState, undecided), 96u);
+    EXPECT_EQ(offsetof(gpu::SlotState, pixel), 112u);
+    EXPECT_EQ(offsetof(gpu::SlotState, finished), 124u);
+    EXPECT_EQ(offsetof(gpu::SlotState, treeRays), 128u);
+    EXPECT_EQ(offsetof(gpu::SlotState, frontierHead), 144u);
+    EXPECT_EQ(offsetof(gpu::SlotState, amplified), 156u);
+    EXPECT_EQ(offsetof(gpu::SlotState, cutOff), 160u);
+    EXPECT_EQ(offsetof(gpu::SlotState, heaviestLeft), 164u);
+    EXPECT_EQ(offsetof(gpu::SlotState, lastMove), 168u);
+    EXPECT_EQ(offsetof(gpu::SlotState, moveBefore), 172u);
+    EXPECT_EQ(offsetof(gpu::SlotState, settledWeight), 176u);
+    EXPECT_EQ(sizeof(gpu::OutputPixel), 64u);
     EXPECT_EQ(offsetof(gpu::OutputPixel, truncation), 16u);
+    EXPECT_EQ(offsetof(gpu::OutputPixel, undecided), 32u);
     EXPECT_EQ(sizeof(gpu::PendingRay), 64u);
     EXPECT_EQ(offsetof(gpu::PendingRay, weight), 32u);
     EXPECT_EQ(offsetof(gpu::PendingRay, depth), 48u);

@@ -257,6 +257,13 @@ vk::FaultInjection faultInjection() {
     }
 }
 
+bool decisionsKept() {
+    const char* decisions = std::getenv("SNELL_DECISIONS");
+    if (!decisions || !*decisions || std::string(decisions) == "on") return true;
+    if (std::string(decisions) == "off") return false;
+    throw InputError(std::string("SNELL_DECISIONS: expected 'on' or 'off', not '") + decisions + "'");
+}
+
 std::uint32_t loopBudgetOverride() {
     const char* budget = std::getenv("SNELL_LOOP_BUDGET");
     if (!budget || !*budget) return 0;

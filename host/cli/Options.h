@@ -105,5 +105,8 @@ std::string pipelineCachePath();
 // suspend-and-resume path with that loop budget (0: unset).
 vk::FaultInjection faultInjection();
 std::uint32_t loopBudgetOverride();
+// False where SNELL_DECISIONS=off asks for a kernel that keeps no rounding
+// margins (measuring what they cost: docs/accuracy.md).
+bool decisionsKept();
 
 }  // namespace snell::cli

@@ -23,6 +23,7 @@
 #include "image/BoundImage.h"
 #include "image/ImageIO.h"
 #include "reference/CpuRenderer.h"
+#include "reference/CpuRetrace.h"
 #include "render/TruncationMessages.h"
 #include "scene/Parser.h"
 #include "vulkan/VulkanContext.h"
@@ -60,7 +61,8 @@ std::string truncationJson(const TruncationReport& t) {
     j << "{\"max_bound\": " << t.maxBound << ", \"mean_bound\": " << t.meanBound()
       << ", \"unbounded_pixels\": " << t.unbounded << ", \"over_budget_pixels\": " << t.overBudget
       << ", \"over_tolerance_pixels\": " << t.overTolerance << ", \"estimated_pixels\": " << t.estimated
-      << ", \"dropped_growing_pixels\": " << t.droppedGrowing
+      << ", \"dropped_growing_pixels\": " << t.droppedGrowing << ", \"undecided_pixels\": " << t.undecided
+      << ", \"retraced_pixels\": " << t.retraced
       << ", \"max_estimated_error\": " << t.maxEstimate << ", \"deepest_ray\": " << t.deepest << "}";
     return j.str();
 }
@@ -351,6 +353,10 @@ RenderOutcome RenderCommand::renderOnGpu(const Scene& scene, RenderRequest& requ
         rendererOptions.precision = o_.device.arithmetic();
         rendererOptions.traversal = o_.device.search();
         if (const std::uint32_t budget = loopBudgetOverride()) rendererOptions.loopBudget = budget;
+        rendererOptions.decisions = decisionsKept();
+        // Pixels whose float decisions stay undecided are traced again in
+        // double by the CPU reference (docs/accuracy.md, "Decisions").
+        request.retrace = cpuRetrace(scene, request);
         rendererOptions.countLanes = o_.countLanes;
         ComputeRenderer renderer(context, scene, request.camera, rendererOptions);
         // The kernel first, compiled for a new scene structure (seconds on

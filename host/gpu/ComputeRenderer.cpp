@@ -107,14 +107,16 @@ GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool count
         const int bandRows = plan.bandRows();
         Image band = request.rowSink ? Image(area.width(), bandRows) : Image();
         const auto* pixels = static_cast<const gpu::OutputPixel*>(k.output.mapped);
+        const gpu::SceneFacts facts{scene_.lights.size(), radianceBound(scene_)};
         gpu::RenderProgress progress;
         for (int ty = 0; ty < plan.tilesY; ++ty) {
             const int bandRow = plan.interleaved ? 0 : ty * plan.tileHeight;
             for (int tx = 0; tx < plan.tilesX; ++tx) {
                 const gpu::TileParams tile = plan.tile(tx, ty);
                 gpu::dispatchTile(context_, k, request, plan, tile, countRays, policy_.countLanes, progress, result);
-                if (request.rowSink) gpu::readBackTile(pixels, request, plan, tile, band, bandRow, progress, result);
-                else gpu::readBackTile(pixels, request, plan, tile, result.image, 0, progress, result);
+                if (request.rowSink)
+                    gpu::readBackTile(pixels, request, plan, tile, facts, band, bandRow, progress, result);
+                else gpu::readBackTile(pixels, request, plan, tile, facts, result.image, 0, progress, result);
             }
             const bool bandDone = !plan.interleaved || ty + 1 == plan.tilesY;
             if (request.rowSink && bandDone) request.rowSink(band.rgb.data(), std::min(bandRows, area.height() - bandRow));

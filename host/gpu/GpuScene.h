@@ -33,11 +33,13 @@ static_assert(offsetof(FrameParams, cornerDir) == 16 &&
               sizeof(FrameParams) == 224 + 32 * SNELL_FRAME_LIGHTS);
 static_assert(sizeof(TileParams) == 32 && offsetof(TileParams, resume) == 16 &&
               offsetof(TileParams, workgroupStride) == 20 && offsetof(TileParams, strideY) == 28);
-static_assert(sizeof(SlotState) == 176 && offsetof(SlotState, lost) == 32 && offsetof(SlotState, pixel) == 96 &&
-              offsetof(SlotState, finished) == 108 && offsetof(SlotState, treeRays) == 112 &&
-              offsetof(SlotState, rays) == 120 && offsetof(SlotState, frontierOld) == 136 &&
-              offsetof(SlotState, cutOff) == 144 && offsetof(SlotState, settledWeight) == 160);
-static_assert(sizeof(OutputPixel) == 32 && offsetof(OutputPixel, truncation) == 16);
+static_assert(sizeof(SlotState) == 192 && offsetof(SlotState, lost) == 32 && offsetof(SlotState, undecided) == 96 &&
+              offsetof(SlotState, pixel) == 112 && offsetof(SlotState, finished) == 124 &&
+              offsetof(SlotState, treeRays) == 128 && offsetof(SlotState, rays) == 136 &&
+              offsetof(SlotState, frontierOld) == 152 && offsetof(SlotState, cutOff) == 160 &&
+              offsetof(SlotState, settledWeight) == 176);
+static_assert(sizeof(OutputPixel) == 64 && offsetof(OutputPixel, truncation) == 16 &&
+              offsetof(OutputPixel, undecided) == 32 && offsetof(OutputPixel, shading) == 48);
 static_assert(sizeof(PendingRay) == 64 && offsetof(PendingRay, depth) == 48 && offsetof(PendingRay, resumeShading) == 60);
 // An ellipsoid's index rides in a float (Sphere::anchorRadius.w), exact to the
 // documented sphere limit.

@@ -48,6 +48,7 @@ KernelPolicy devicePolicy(vk::Context& context, const RendererOptions& options, 
                               layout.bvhStackSize() <= SNELL_REGISTER_STACK_LIMIT;
     const std::uint32_t driverBudget = limitsLoopIterations(context) ? SNELL_LOOP_BUDGET_LIMITED : 0u;
     policy.loopBudget = options.loopBudget.value_or(driverBudget);
+    policy.decisions = options.decisions;
     // A batch of shadow rays is numbered within 32 bits, min(4, 32 / subgroup
     // size) lights at a time: worth it for SIMD rows of up to 16 lanes. On a
     // CPU device only, where a subgroup's lanes run in lockstep: a GPU's would
@@ -122,6 +123,7 @@ void specialiseToScene(const GpuScene& layout, const KernelPolicy& policy, Speci
     values[SNELL_SPEC_SHARE_SHADOW_RAYS] = policy.sharesShadowRays;
     values[SNELL_SPEC_LIGHTS_IN_FRAME] = layout.lightsInFrame();
     values[SNELL_SPEC_STACKS_BY_ADDRESS] = policy.stacksByAddress;
+    values[SNELL_SPEC_DECISIONS] = policy.decisions;
     values[SNELL_SPEC_HAS_ELLIPSOIDS] = !layout.ellipsoids.empty();
     values[SNELL_SPEC_HAS_LIGHTS] = !layout.lights.empty();
     values[SNELL_SPEC_MAX_MEDIA] = static_cast<std::uint32_t>(

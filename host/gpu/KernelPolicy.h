@@ -31,6 +31,7 @@ struct KernelPolicy {
     bool spheresInBlock = false;    // every sphere in the uniform block (shared_layout.h)
     bool planForCpu = false;        // invocations, frontiers and shares as for a CPU device
     bool countLanes = false;
+    bool decisions = true;          // decisions keep their rounding margins (physics/margins.glsl)
     std::uint32_t loopBudget = 0;   // loop iterations before the invocations suspend, else 0
 };
 

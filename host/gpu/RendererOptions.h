@@ -25,6 +25,9 @@ struct RendererOptions {
     std::optional<std::uint32_t> loopBudget;
     // Measuring: count the lanes busy in each loop pass (GpuRenderResult::lanes; slower).
     bool countLanes = false;
+    // Measuring: false keeps no rounding margins (SNELL_DECISIONS=off): no
+    // pixel is found undecided, and the bound covers truncation only.
+    bool decisions = true;
     // Testing: plan as for a GPU (its invocations, frontiers and shares) on a
     // CPU device, so lavapipe runs the paths a GPU takes. A fixed tree's image
     // is the same; under a tolerance the shorter frontiers may trace some

@@ -10,8 +10,15 @@ namespace snell::gpu {
 
 // `rows` is the image, or the band being streamed, whose first row is
 // `firstRow` of the window; also fills the request's bound and ray images.
+// A pixel the kernel left undecided (physics/margins.glsl) is re-traced by
+// request.retrace where that is set and its undecided light is more than a
+// bound should take, else its bound is widened.
+struct SceneFacts {
+    std::size_t lights = 0;
+    RadianceBound radiance;  // render/Truncation.h
+};
 void readBackTile(const OutputPixel* pixels, const RenderRequest& request, const TilePlan& plan,
-                  const TileParams& tile, Image& rows, int firstRow, RenderProgress& progress,
+                  const TileParams& tile, const SceneFacts& facts, Image& rows, int firstRow, RenderProgress& progress,
                   GpuRenderResult& result);
 
 }  // namespace snell::gpu

@@ -88,21 +88,6 @@ double crossSurface(const Scene& scene, bool entering, const Material& m, std::u
     return m.eta / innermostEta();
 }
 
-bool rayHitsBox(const Aabb& box, const dvec3& origin, const dvec3& inverseDir, double tMax) {
-    // Slab test; inverseDir components may be ±inf, which the min/max handle.
-    double t0 = 0.0, t1 = tMax;
-    for (int k = 0; k < 3; ++k) {
-        double a = (box.lower[k] - origin[k]) * inverseDir[k];
-        double b = (box.upper[k] - origin[k]) * inverseDir[k];
-        if (std::isnan(a) || std::isnan(b)) continue;  // origin on a slab plane, parallel ray
-        if (a > b) std::swap(a, b);
-        t0 = std::max(t0, a);
-        t1 = std::min(t1, b);
-        if (t0 > t1) return false;
-    }
-    return true;
-}
-
 }  // namespace
 
 // Where a ray met its closest surface, and what shading needs there.
@@ -113,6 +98,11 @@ struct CpuRenderer::Hit {
     dvec3 point{0.0};
     dvec3 normal{0.0};         // the shading normal N (against the ray)
     bool fromOutside = false;  // the ray arrived from outside the sphere
+    double pointOff = 0.0;     // how far the point and the normal may be from the
+    double normalOff = 0.0;    // exact ray's (Margins.h)
+    double rounding = 0.0;     // of the point itself, and how fast the normal turns
+    double turning = 0.0;      // with it (outwardNormal)
+    bool undecided = false;    // the exact ray may meet another surface, none, or this one from its other side
 };
 
 struct CpuRenderer::PendingRay {
@@ -123,6 +113,8 @@ struct CpuRenderer::PendingRay {
     bool inward = false;               // it starts into that sphere
     bool refracted = false;
     MediumStack media;
+    margins::Uncertainty off;  // how far it may be from the exact ray (Margins.h)
+    bool covered = false;      // an undecided ancestor's widening already covers its light
 };
 
 // One hit's children: the reflected ray, and the refracted one unless total
@@ -130,6 +122,7 @@ struct CpuRenderer::PendingRay {
 struct CpuRenderer::Children {
     PendingRay reflected;
     std::optional<PendingRay> refracted;
+    bool undecided = false;  // total internal reflection or not is within its margin
 };
 
 // What a pixel's trees did not trace so far (render/Truncation.h): the weight
@@ -148,6 +141,19 @@ struct CpuRenderer::TreeTrace {
     bool amplified = false;       // a hit met a trap (growthTraps) with light of a gain > 1
     const std::vector<bool>* traps = nullptr;  // per material (growthTraps)
     bool anyTrap = false;
+    // Where a decision was undecided (Margins.h): the weight of the rays whose
+    // light either outcome may change (each by at most its weight times R),
+    // and the light of terms that may be off (shadow rays, shading's rounding).
+    dvec3 undecidedWeight{0.0};
+    dvec3 undecidedLight{0.0};
+    bool undecided = false;
+
+    // Ray r's light below this point may be either outcome's.
+    void widen(PendingRay& r, const dvec3& weight) {
+        undecided = true;
+        if (!r.covered) undecidedWeight += weight;
+        r.covered = true;
+    }
 
     // A ray under the cut-off: the next, lower cut-off starts from it (under
     // the floor no cut-off will, and it is lost; but in a scene with traps a
@@ -187,78 +193,6 @@ std::shared_ptr<const std::vector<bool>> CpuRenderer::trapsFor(const dvec3& eye)
     return traps_;
 }
 
-double CpuRenderer::intersect(std::uint32_t index, const Ray& ray, std::uint32_t fromSphere,
-                              StartsOn start) const {
-    const Sphere& s = scene_.spheres[index];
-    const StartsOn mode = index == fromSphere ? start : StartsOn::Elsewhere;
-    if (s.isTrueSphere) return intersectSphere(s.centre, s.radius, ray, mode);
-    const dvec3 o = dvec3(s.objectFromWorld * glm::dvec4(ray.origin, 1.0));
-    const glm::dmat3 m(s.objectFromWorld);
-    const dvec3 d = m * ray.direction;
-    // Rounding of o: of the origin through the matrix, and of the product.
-    double matrixNorm = 0.0;
-    for (int row = 0; row < 3; ++row)
-        matrixNorm = std::max(matrixNorm, std::abs(m[0][row]) + std::abs(m[1][row]) + std::abs(m[2][row]));
-    const double tolerance = kRounding * (glm::length(o) + 1.0 + matrixNorm * glm::length(ray.origin));
-    return intersectUnitSphere(o, d, mode, tolerance);
-}
-
-bool CpuRenderer::closestHit(const Ray& ray, std::uint32_t fromSphere, StartsOn start, Hit& hit) const {
-    hit = Hit{};
-    auto test = [&](std::uint32_t i) {
-        const double t = intersect(i, ray, fromSphere, start);
-        if (t < hit.t) { hit.t = t; hit.sphere = i; }
-    };
-    if (!useBvh_) {
-        for (std::uint32_t i = 0; i < scene_.spheres.size(); ++i) test(i);
-        return hit.sphere != kNone;
-    }
-    const dvec3 inverseDir = 1.0 / ray.direction;
-    std::uint32_t stack[128];
-    int top = 0;
-    stack[top++] = 0;
-    while (top > 0) {
-        const BvhNode& node = bvh_.nodes[stack[--top]];
-        if (!rayHitsBox(node.bounds, ray.origin, inverseDir, hit.t)) continue;
-        if (node.count > 0) {
-            for (std::uint32_t k = 0; k < node.count; ++k) test(bvh_.order[node.first + k]);
-        } else {
-            stack[top++] = node.first;
-            stack[top++] = node.first + 1;
-        }
-    }
-    return hit.sphere != kNone;
-}
-
-bool CpuRenderer::occluded(const Ray& ray, double distance, std::uint32_t fromSphere, StartsOn start) const {
-    // SPEC §4.3: blocked if a surface crosses the open segment (0, distance).
-    // A ray that starts on a sphere headed into it (shading a hit from inside)
-    // crosses that sphere at its chord unless the light is nearer: that one
-    // test first spares the search its answer.
-    if (start == StartsOn::Entering && intersect(fromSphere, ray, fromSphere, start) < distance) return true;
-    if (!useBvh_) {
-        for (std::uint32_t i = 0; i < scene_.spheres.size(); ++i)
-            if (intersect(i, ray, fromSphere, start) < distance) return true;
-        return false;
-    }
-    const dvec3 inverseDir = 1.0 / ray.direction;
-    std::uint32_t stack[128];
-    int top = 0;
-    stack[top++] = 0;
-    while (top > 0) {
-        const BvhNode& node = bvh_.nodes[stack[--top]];
-        if (!rayHitsBox(node.bounds, ray.origin, inverseDir, distance)) continue;
-        if (node.count > 0) {
-            for (std::uint32_t k = 0; k < node.count; ++k)
-                if (intersect(bvh_.order[node.first + k], ray, fromSphere, start) < distance) return true;
-        } else {
-            stack[top++] = node.first;
-            stack[top++] = node.first + 1;
-        }
-    }
-    return false;
-}
-
 // SPEC §3: sub-pixel sample k = b·s + a of pixel (x, y): the ray through
 // (x + (a + ½)/s, y + (b + ½)/s), from the eye.
 CpuRenderer::PendingRay CpuRenderer::cameraRay(const Camera& camera, int s, int x, int y, int k) {
@@ -267,30 +201,52 @@ CpuRenderer::PendingRay CpuRenderer::cameraRay(const Camera& camera, int s, int 
     const double py = y + (b + 0.5) / s;
     PendingRay primary;
     primary.ray = {camera.eye, camera.direction(px, py)};
+    primary.off = {margins::kChain * kUnitRoundoff * glm::length(camera.eye), margins::kChain * kUnitRoundoff};
     return primary;
 }
 
 // The outward normal No of `sphere` at the point o + t d of `ray` (an
-// ellipsoid's through its object frame: the transposed inverse map).
-dvec3 CpuRenderer::outwardNormal(const Sphere& sphere, const Ray& ray, double t) const {
-    if (sphere.isTrueSphere) return glm::normalize(ray.origin - sphere.centre + t * ray.direction);
+// ellipsoid's through its object frame: the transposed inverse map), and how
+// much an offset of the point turns it (Margins.h, normalOff): 1/r on a true
+// sphere; on an ellipsoid, where n = Mᵀ M x, the part of Mᵀ M δ across n over
+// |n|, which at most ‖(I − N Nᵀ) Mᵀ M‖ (Frobenius) δ / |n| (Margins.h, turning).
+dvec3 CpuRenderer::outwardNormal(const Sphere& sphere, const Ray& ray, double t, double& turning) const {
+    if (sphere.isTrueSphere) {
+        turning = 1.0 / sphere.radius;
+        return glm::normalize(ray.origin - sphere.centre + t * ray.direction);
+    }
     const dvec3 o = dvec3(sphere.objectFromWorld * glm::dvec4(ray.origin, 1.0));
     const dvec3 p = o + t * (glm::dmat3(sphere.objectFromWorld) * ray.direction);
-    return glm::normalize(glm::transpose(glm::dmat3(sphere.objectFromWorld)) * p);
+    const glm::dmat3 m(sphere.objectFromWorld);
+    const dvec3 normal = glm::transpose(m) * p;
+    turning = margins::turning(glm::transpose(m) * m, normal);
+    return glm::normalize(normal);
 }
 
 // 1–2. The closest hit of ray r (SPEC §4.1), and what shading needs there:
 // the material, the point, and the shading normal N. False on a miss.
 bool CpuRenderer::findHit(const PendingRay& r, Hit& hit) const {
     const StartsOn start = r.inward ? StartsOn::Entering : StartsOn::Leaving;
-    if (!closestHit(r.ray, r.fromSphere, start, hit)) return false;
+    const Closest closest = closestHit(r.ray, r.fromSphere, start, r.off);
+    hit.t = closest.t;
+    hit.sphere = closest.sphere;
+    hit.undecided = closest.undecided;
+    if (closest.sphere == kNone) return false;
     const Sphere& sphere = scene_.spheres[hit.sphere];
     hit.material = &scene_.materials[sphere.material];
     // The hit point is o + t d, not re-projected (shaders/physics/hit.glsl says why).
     hit.point = r.ray.origin + hit.t * r.ray.direction;
-    const dvec3 outward = outwardNormal(sphere, r.ray, hit.t);
-    hit.fromOutside = glm::dot(r.ray.direction, outward) < 0.0;
+    double turning = 0.0;
+    const dvec3 outward = outwardNormal(sphere, r.ray, hit.t, turning);
+    const double facing = glm::dot(r.ray.direction, outward);
+    hit.fromOutside = facing < 0.0;
     hit.normal = hit.fromOutside ? outward : -outward;
+    // How sure: the point, its normal, and which side the ray came from.
+    hit.rounding = margins::kChain * kUnitRoundoff * (glm::length(r.ray.origin) + hit.t);
+    hit.turning = turning;
+    hit.pointOff = closest.margin + hit.rounding;
+    hit.normalOff = margins::normalOff(hit.pointOff, turning, kUnitRoundoff);
+    if (std::abs(facing) <= margins::facingMargin(r.off.tilt, hit.normalOff, kUnitRoundoff)) hit.undecided = true;
     return true;
 }
 
@@ -300,7 +256,7 @@ dvec3 CpuRenderer::ambientTerm(const Hit& hit) const { return scene_.ambient * h
 // Light's part of the local term at a hit, seen from v, with a binary shadow
 // (SPEC §4.3); castShadowRay: a shadow ray was cast (the surface faces the light).
 dvec3 CpuRenderer::shadeLight(const Light& light, const Hit& hit, const dvec3& v, const TraceSettings& settings,
-                              bool& castShadowRay) const {
+                              bool& castShadowRay, Uncertain& uncertain) const {
     castShadowRay = false;
     dvec3 l = light.position - hit.point;
     const double distance = glm::length(l);
@@ -310,23 +266,35 @@ dvec3 CpuRenderer::shadeLight(const Light& light, const Hit& hit, const dvec3& v
     castShadowRay = settings.shadows;
     // A shadow ray towards N's side enters the sphere only when N = −No.
     const StartsOn start = hit.fromOutside ? StartsOn::Leaving : StartsOn::Entering;
-    if (settings.shadows && occluded({hit.point, l}, distance, hit.sphere, start)) return dvec3(0.0);
+    const margins::Uncertainty toLight{hit.pointOff, hit.pointOff / distance + margins::kChain * kUnitRoundoff};
+    bool undecided = false;
+    const bool blocked = settings.shadows && occluded({hit.point, l}, distance, hit.sphere, start, toLight, undecided);
     const Material& m = *hit.material;
     const dvec3 reflectedLight = 2.0 * nl * hit.normal - l;
     const double rv = glm::dot(reflectedLight, v);
     const double specular = rv > 0.0 ? std::pow(rv, m.phong) : 0.0;
-    return light.colour * (m.kd * nl + m.ks * specular);
+    const dvec3 term = light.colour * (m.kd * nl + m.ks * specular);
+    // Either side of a shadow's edge; and N·L and R·V off by the normal's and
+    // the direction's uncertainty: kd·δ, and p (R·V)^(p−1) δ for (R·V)^p.
+    if (undecided) {
+        uncertain.light += term;
+        uncertain.undecided = true;
+    }
+    const double cosineOff = 2.0 * (hit.normalOff + toLight.tilt) + margins::kChain * kUnitRoundoff;
+    const double specularOff = rv > 0.0 ? specular * m.phong * cosineOff / rv : 0.0;
+    if (!blocked) uncertain.light += light.colour * (m.kd * cosineOff + m.ks * specularOff);
+    return blocked ? dvec3(0.0) : term;
 }
 
 // The whole local term: ambient, then each light in order. (The shader adds
 // each part to the pixel as it goes, so that a dispatch may stop between
 // lights: the same terms, summed in another order.)
-dvec3 CpuRenderer::localTerm(const Hit& hit, const dvec3& v, const TraceSettings& settings,
-                             RayCounts& counts) const {
+dvec3 CpuRenderer::localTerm(const Hit& hit, const dvec3& v, const TraceSettings& settings, RayCounts& counts,
+                             Uncertain& uncertain) const {
     dvec3 local = ambientTerm(hit);
     for (const Light& light : scene_.lights) {
         bool castShadowRay = false;
-        const dvec3 term = shadeLight(light, hit, v, settings, castShadowRay);
+        const dvec3 term = shadeLight(light, hit, v, settings, castShadowRay, uncertain);
         if (castShadowRay) ++counts.shadow;
         local += term;
     }
@@ -341,23 +309,30 @@ CpuRenderer::Children CpuRenderer::children(const PendingRay& r, const Hit& hit,
     const Material& m = *hit.material;
     const dvec3 d = r.ray.direction;
     Children c;
+    const margins::Hand hand{hit.pointOff, hit.t, hit.rounding, hit.turning, hit.fromOutside};
     dvec3 reflectedWeight = childWeight(r.weight, settings.reflection ? m.ks : dvec3(0.0));
     if (settings.refraction && m.refracts()) {
         const dvec3 transmittedWeight = childWeight(r.weight, m.kt);
         MediumStack media = r.media;
         const double eta = crossSurface(scene_, hit.fromOutside, m, hit.sphere, media);
         dvec3 refracted;
+        const double cosine = -glm::dot(hit.normal, d);
+        const double k = 1.0 - eta * eta * (1.0 - cosine * cosine);  // refractDirection's
+        c.undecided = std::abs(k) <= margins::reflectionMargin(eta, r.off.tilt + hit.normalOff, kUnitRoundoff);
         if (!refractDirection(d, hit.normal, eta, refracted)) {
             // Total internal reflection is the reflected ray in the same
             // medium: one ray carrying both weights (exactly SPEC §4.5).
             reflectedWeight = glm::min(reflectedWeight + transmittedWeight, dvec3(kMaxWeight));
         } else {
             c.refracted = PendingRay{{hit.point, refracted}, transmittedWeight, r.depth + 1, hit.sphere,
-                                     hit.fromOutside, true, media};
+                                     hit.fromOutside, true, media,
+                                     margins::refracted(r.off, hand, eta, k, kUnitRoundoff),
+                                     r.covered};
         }
     }
     c.reflected = PendingRay{{hit.point, reflectDirection(d, hit.normal)}, reflectedWeight, r.depth + 1, hit.sphere,
-                             !hit.fromOutside, false, r.media};
+                             !hit.fromOutside, false, r.media,
+                             margins::reflected(r.off, hand, kUnitRoundoff), r.covered};
     return c;
 }
 
@@ -404,6 +379,14 @@ void CpuRenderer::followChildren(const PendingRay& r, const Hit& hit, double cut
         for (int c = 0; c < 3; ++c)
             if (gain[c] > 1.0 && r.weight[c] > 0.0) tree.amplified = true;
     Children c = children(r, hit, settings);
+    if (c.undecided && !r.covered) {
+        // Reflected or refracted: either outcome's children carry light
+        // within their weights times R.
+        tree.undecided = true;
+        tree.undecidedWeight += weighted(r.weight, gain);
+        c.reflected.covered = true;
+        if (c.refracted) c.refracted->covered = true;
+    }
     std::optional<PendingRay> refractedRay, reflectedRay;
     if (c.refracted) {
         if (worthTracing(c.refracted->weight, cutOff)) refractedRay = std::move(c.refracted);
@@ -434,14 +417,20 @@ void CpuRenderer::traceTree(const PendingRay& root, dvec3& pixelSum, double satu
         PendingRay r = std::move(stack.back());
         stack.pop_back();
         if (!admitRay(r, pixelSum, saturation, cutOff, settings, counts, tree)) continue;
-        // 1–2. The closest hit; the background on a miss.
+        // 1–2. The closest hit; the background on a miss. Where rounding may
+        // have chosen it, the light of the ray is either outcome's.
         Hit hit;
-        if (!findHit(r, hit)) {
+        const bool met = findHit(r, hit);
+        if (hit.undecided) tree.widen(r, r.weight);
+        if (!met) {
             addWeighted(pixelSum, r.weight, scene_.background);
             continue;
         }
         // 3. The local Phong term with binary shadows.
-        addWeighted(pixelSum, r.weight, localTerm(hit, -r.ray.direction, settings, counts));
+        Uncertain uncertain;
+        addWeighted(pixelSum, r.weight, localTerm(hit, -r.ray.direction, settings, counts, uncertain));
+        if (!r.covered) tree.undecidedLight += weighted(r.weight, uncertain.light);
+        tree.undecided = tree.undecided || uncertain.undecided;
         // 4–5. The children: reflection, and refraction through the medium stack.
         followChildren(r, hit, cutOff, settings, tree, stack);
     }
@@ -515,86 +504,30 @@ CpuRenderer::Pixel CpuRenderer::renderPixel(const RenderRequest& request, int x,
         tree.heaviestDeferred = 0.0;
         for (const PendingRay& r : waiting) traceTree(r, sum, saturation, cutOff, settings, counts, tree);
     }
+    // Where a decision was undecided, or rounding may have moved a term, the
+    // exact colour may lie on either side: the bound widens by that light
+    // (Margins.h), and by the rounding of the sums and of the weights (each
+    // at most `deepest` + lights + a few rounded factors or terms). Where R
+    // is infinite an undecided ray's light has no bound: the pixel has none,
+    // and its estimated error grows by that ray's weight times the most light
+    // one hit returns (as for light not traced, ErrorEstimate).
+    pixel.undecided = tree.undecided;
+    const double terms = tree.deepest + double(scene_.lights.size()) + 4.0;
+    const double rounding =
+        margins::kChain * kUnitRoundoff * terms * (maxComponent(glm::abs(pixel.colour)) + pixel.bound);
+    const dvec3 spread = weighted(tree.undecidedWeight, radiance_.radiance) + tree.undecidedLight;
+    pixel.widening = maxComponent(spread) / samples + rounding;
+    if (std::isfinite(pixel.widening)) {
+        pixel.bound = std::min(1.0, pixel.bound + pixel.widening);
+    } else {
+        pixel.bound = std::max(pixel.bound, 1.0 - maxComponent(glm::min(pixel.colour, dvec3(1.0))));
+        const double guess = maxComponent(weighted(tree.undecidedWeight, radiance_.local) + tree.undecidedLight);
+        if (!pixel.unbounded || std::isfinite(pixel.estimatedError))
+            pixel.estimatedError = (pixel.unbounded ? pixel.estimatedError : 0.0) + guess / samples;
+        pixel.unbounded = true;
+        pixel.overTolerance = pixel.overTolerance || pixel.estimatedError > settings.tolerance;
+    }
     return pixel;
-}
-
-Image CpuRenderer::render(const RenderRequest& request, RayCounts* counts) const {
-    // The window rendered (the whole image unless asked), in bands of rows:
-    // all of them at once for an image in memory, 32 at a time when the rows
-    // stream to a sink. Pixel coordinates stay those of the whole image.
-    const PixelWindow area = request.area();
-    const int width = area.width(), height = area.height();
-    const int bandRows = request.rowSink ? std::min(32, height) : height;
-    Image band(width, bandRows);
-    Image image = request.rowSink ? Image() : Image(width, height);
-    const int threads = request.threads > 0
-                            ? request.threads
-                            : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-    std::vector<RayCounts> perThread(threads);
-    std::vector<TruncationReport> truncation(threads);
-    request.startTruncationImages(static_cast<std::size_t>(width) * height);
-    std::atomic<int> rowsDone{0};
-    std::atomic<std::uint64_t> raysTraced{0};
-    for (int bandStart = 0; bandStart < height; bandStart += bandRows) {
-        const int rows = std::min(bandRows, height - bandStart);
-        Image& target = request.rowSink ? band : image;
-        const int targetOffset = request.rowSink ? bandStart : 0;
-        std::atomic<int> nextRow{bandStart};
-        auto work = [&](int id) {
-            RayCounts& local = perThread[id];
-            std::uint64_t raysBefore = local.total();
-            for (int row; (row = nextRow.fetch_add(1)) < bandStart + rows;) {
-                if (request.cancel && request.cancel->load()) return;
-                const int y = area.y0 + row;
-                for (int column = 0; column < width; ++column) {
-                    const int x = area.x0 + column;
-                    const Pixel pixel = renderPixel(request, x, y, local);
-                    const dvec3 c = pixel.colour;
-                    TruncationReport& t = truncation[id];
-                    PixelTruncation outcome;
-                    outcome.x = x;
-                    outcome.y = y;
-                    outcome.bound = pixel.bound;
-                    outcome.unbounded = pixel.unbounded;
-                    outcome.overBudget = pixel.overBudget;
-                    outcome.overTolerance = pixel.overTolerance;
-                    outcome.estimated = pixel.estimated;
-                    outcome.estimatedError = pixel.estimatedError;
-                    t.add(outcome);
-                    t.deepest = std::max(t.deepest, pixel.deepest);
-                    request.recordTruncation(static_cast<std::size_t>(row) * width + column, outcome);
-                    float* p = target.pixel(column, row - targetOffset);
-                    p[0] = static_cast<float>(c.x);
-                    p[1] = static_cast<float>(c.y);
-                    p[2] = static_cast<float>(c.z);
-                }
-                const int done = rowsDone.fetch_add(1) + 1;
-                const std::uint64_t rays = raysTraced.fetch_add(local.total() - raysBefore) + local.total() - raysBefore;
-                raysBefore = local.total();
-                if (request.progress) request.progress(static_cast<double>(done) / height, rays);
-            }
-        };
-        std::vector<std::thread> pool;
-        for (int t = 1; t < threads; ++t) pool.emplace_back(work, t);
-        work(0);
-        for (std::thread& t : pool) t.join();
-        if (request.cancel && request.cancel->load()) break;
-        if (request.rowSink) request.rowSink(band.rgb.data(), rows);
-    }
-    if (request.truncation) {
-        *request.truncation = TruncationReport{};
-        for (const TruncationReport& t : truncation) request.truncation->merge(t);
-    }
-    if (counts) {
-        *counts = RayCounts{};
-        for (const RayCounts& c : perThread) {
-            counts->primary += c.primary;
-            counts->shadow += c.shadow;
-            counts->reflected += c.reflected;
-            counts->refracted += c.refracted;
-        }
-    }
-    return image;
 }
 
 }  // namespace snell

@@ -33,9 +33,24 @@ public:
         bool estimated = false;     // unbounded, and stopped by its estimated error (render/Truncation.h)
         double estimatedError = std::numeric_limits<double>::infinity();  // the last one made (+inf: none)
         int deepest = 0;            // the deepest ray traced
+        // A decision of its trees was within its rounding margin (Margins.h):
+        // both outcomes are covered, so `bound` holds on both sides of the
+        // colour, and `widening` of it is that.
+        bool undecided = false;
+        double widening = 0.0;
+        // As a renderer reports it, for pixel (x, y).
+        PixelTruncation truncation(int x, int y) const;
     };
     Pixel renderPixel(const RenderRequest& request, int x, int y, RayCounts& counts) const;
     const RadianceBound& radiance() const { return radiance_; }
+
+    // The closest hit of a ray (SPEC §4.1) and how sure it is (Margins.h).
+    struct Closest {
+        double t = kNoHit;
+        std::uint32_t sphere = 0xffffffffu;
+        double margin = 0.0;     // the exact hit lies within this of t
+        bool undecided = false;  // the exact ray may hit another sphere first, or none
+    };
 
 private:
     struct Hit;
@@ -48,18 +63,29 @@ private:
     bool admitRay(PendingRay& r, const glm::dvec3& pixelSum, double saturation, double cutOff,
                   const TraceSettings& settings, RayCounts& counts, TreeTrace& tree) const;
     bool findHit(const PendingRay& r, Hit& hit) const;
-    glm::dvec3 outwardNormal(const Sphere& sphere, const Ray& ray, double t) const;
-    glm::dvec3 localTerm(const Hit& hit, const glm::dvec3& v, const TraceSettings& settings,
-                         RayCounts& counts) const;
+    glm::dvec3 outwardNormal(const Sphere& sphere, const Ray& ray, double t, double& turning) const;
+    // What of a local term may be off: the light of shadow rays whose answer
+    // is undecided, and shading's rounding (Margins.h).
+    struct Uncertain {
+        glm::dvec3 light{0.0};
+        bool undecided = false;
+    };
+    glm::dvec3 localTerm(const Hit& hit, const glm::dvec3& v, const TraceSettings& settings, RayCounts& counts,
+                         Uncertain& uncertain) const;
     glm::dvec3 ambientTerm(const Hit& hit) const;
     glm::dvec3 shadeLight(const Light& light, const Hit& hit, const glm::dvec3& v, const TraceSettings& settings,
-                          bool& castShadowRay) const;
+                          bool& castShadowRay, Uncertain& uncertain) const;
     void followChildren(const PendingRay& r, const Hit& hit, double cutOff, const TraceSettings& settings,
                         TreeTrace& tree, std::vector<PendingRay>& stack) const;
     Children children(const PendingRay& r, const Hit& hit, const TraceSettings& settings) const;
-    bool closestHit(const Ray& ray, std::uint32_t fromSphere, StartsOn start, Hit& hit) const;
-    bool occluded(const Ray& ray, double distance, std::uint32_t fromSphere, StartsOn start) const;
-    double intersect(std::uint32_t sphere, const Ray& ray, std::uint32_t fromSphere, StartsOn start) const;
+    Closest closestHit(const Ray& ray, std::uint32_t fromSphere, StartsOn start,
+                       const margins::Uncertainty& off) const;
+    // SPEC §4.3 visibility; `undecided`: the exact ray's answer may differ.
+    bool occluded(const Ray& ray, double distance, std::uint32_t fromSphere, StartsOn start,
+                  const margins::Uncertainty& off, bool& undecided) const;
+    Crossing intersect(std::uint32_t sphere, const Ray& ray, std::uint32_t fromSphere, StartsOn start,
+                       const margins::Uncertainty& off) const;
+
 
     // growthTraps for a render's eye, kept for the next render from there.
     std::shared_ptr<const std::vector<bool>> trapsFor(const glm::dvec3& eye) const;

@@ -22,6 +22,8 @@
 
 #include <glm/glm.hpp>
 
+#include "render/Margins.h"
+
 namespace snell {
 
 struct Ray {
@@ -35,56 +37,122 @@ enum class StartsOn { Elsewhere, Leaving, Entering };
 inline constexpr double kNoHit = std::numeric_limits<double>::infinity();
 // Four units of double rounding: the band around a surface within which a ray
 // origin counts as on it.
-inline constexpr double kRounding = 4.0 * std::numeric_limits<double>::epsilon() / 2.0;
+inline constexpr double kUnitRoundoff = std::numeric_limits<double>::epsilon() / 2.0;
+inline constexpr double kRounding = 4.0 * kUnitRoundoff;
 
-// Smallest root t > 0 of |o + t d|^2 = 1 for the unit sphere, given o and d in
-// the sphere's own frame (d not necessarily unit); kNoHit if none.
-// `tolerance`: how far (object units) rounding may have put o off the surface.
-inline double intersectUnitSphere(const glm::dvec3& o, const glm::dvec3& d, StartsOn start, double tolerance = 0.0) {
+// A ray's crossing of one sphere and how sure it is (Margins.h): the exact
+// ray meets it within `margin` of t, not before `rivalFrom` (a near miss may
+// be a hit there), and `grazing`: it may miss it altogether.
+struct Crossing {
+    double t = kNoHit;
+    double margin = 0.0;
+    double rivalFrom = kNoHit;
+    bool grazing = false;
+};
+
+// A ray that starts within rounding of a surface it does not start on meets
+// it at once if it heads in, and not if it heads out (the header's rule); in
+// exact arithmetic the origin may be on either side: undecided.
+inline Crossing nearSurface(double b) { return b < 0.0 ? Crossing{0.0, 0.0, 0.0, true} : Crossing{kNoHit, 0.0, 0.0, false}; }
+
+// The crossing of the ray o + t d (object frame; d not unit, so t is the world
+// ray's parameter) with the unit sphere. The world ray is off by `uncertainty`
+// at world scale `scale`; `stretch` bounds how far across itself
+// objectFromWorld moves the line for a world offset of 1 (Margins.h,
+// acrossStretch). A hit moves along the ray by the offset across the line over
+// the half-chord, and by the offset along it. The cases are the header's:
+// leaving, entering (the chord root), within rounding of the surface, the
+// q-form roots.
+inline Crossing crossUnitSphere(const glm::dvec3& o, const glm::dvec3& d, StartsOn start, double tolerance,
+                                const margins::Uncertainty& uncertainty, double stretch, double scale) {
     const double a = glm::dot(d, d);
     const double b = glm::dot(o, d);
-    if (start == StartsOn::Leaving) return kNoHit;
+    const double length = std::sqrt(a);
+    // How far the ray's line may be from the exact one's in this frame, near t;
+    // and the world offset there, which moves a hit along the ray.
+    auto worldOff = [&](double t) { return margins::offAt(uncertainty, t, scale, kUnitRoundoff); };
+    auto offAt = [&](double t) {
+        return stretch * worldOff(t) + margins::kChain * kUnitRoundoff * (glm::length(o) + 1.0);
+    };
+    if (start == StartsOn::Leaving) return {};
     if (start == StartsOn::Entering) {
         const double chord = -2.0 * b / a;
-        return chord > 0.0 ? chord : kNoHit;
+        const double margin =
+            margins::hitMargin(1.0, std::abs(b) / length, offAt(std::max(chord, 0.0))) / length + worldOff(chord);
+        return chord > 0.0 ? Crossing{chord, margin, chord - margin, chord <= margin} : Crossing{};
     }
     const glm::dvec3 perpendicular = o - (b / a) * d;
     const double discriminant = a * (1.0 - glm::dot(perpendicular, perpendicular));
-    if (discriminant < 0.0) return kNoHit;
-    if (std::abs(glm::length(o) - 1.0) <= tolerance) return b < 0.0 ? 0.0 : kNoHit;
+    if (discriminant < 0.0) {
+        const double closest = -b / a;  // a near miss may be a hit about there
+        const double off = offAt(std::max(closest, 0.0));
+        const double decides = a * margins::discriminantMargin(1.0, off);
+        if (discriminant > -decides && closest + off / length > 0.0)
+            return {kNoHit, 0.0, std::max(0.0, closest - (std::sqrt(decides / a) + off) / length), false};
+        return {};
+    }
+    if (std::abs(glm::length(o) - 1.0) <= tolerance) return nearSurface(b);
     const double q = -(b + std::copysign(std::sqrt(discriminant), b));
-    if (q == 0.0) return kNoHit;
+    if (q == 0.0) return {};
     const double c = glm::dot(o, o) - 1.0;
     double t0 = c / q, t1 = q / a;
     if (t0 > t1) std::swap(t0, t1);
-    if (t0 > 0.0) return t0;
-    if (t1 > 0.0) return t1;
-    return kNoHit;
+    const double t = t0 > 0.0 ? t0 : (t1 > 0.0 ? t1 : kNoHit);
+    if (t == kNoHit) return {};
+    const double off = offAt(t);
+    const double margin = margins::hitMargin(1.0, std::sqrt(discriminant / a), off) / length + worldOff(t);
+    return {t, margin, t - margin, discriminant <= a * margins::discriminantMargin(1.0, off)};
+}
+
+// The same for a true sphere (centre, radius) and a unit direction, the ray
+// off by `uncertainty` (world units).
+inline Crossing crossSphere(const glm::dvec3& centre, double radius, const Ray& ray, StartsOn start,
+                            const margins::Uncertainty& uncertainty) {
+    const double scale = glm::length(ray.origin) + glm::length(centre) + radius;
+    const double tolerance = kRounding * scale;
+    const glm::dvec3 f = ray.origin - centre;
+    const double b = glm::dot(f, ray.direction);
+    if (start == StartsOn::Leaving) return {};
+    if (start == StartsOn::Entering) {
+        const double chord = -2.0 * b;
+        const double margin =
+            margins::hitMargin(radius, std::abs(b), margins::offAt(uncertainty, std::max(chord, 0.0), scale, kUnitRoundoff));
+        return chord > 0.0 ? Crossing{chord, margin, chord - margin, chord <= margin} : Crossing{};
+    }
+    const glm::dvec3 perpendicular = f - b * ray.direction;
+    const double discriminant = radius * radius - glm::dot(perpendicular, perpendicular);
+    if (discriminant < 0.0) {
+        const double off = margins::offAt(uncertainty, std::max(-b, 0.0), scale, kUnitRoundoff);
+        const double decides = margins::discriminantMargin(radius, off);
+        if (discriminant > -decides && -b + off > 0.0)
+            return {kNoHit, 0.0, std::max(0.0, -b - std::sqrt(decides) - off), false};
+        return {};
+    }
+    if (std::abs(glm::length(f) - radius) <= tolerance) return nearSurface(b);
+    const double q = -(b + std::copysign(std::sqrt(discriminant), b));
+    if (q == 0.0) return {};
+    const double c = glm::dot(f, f) - radius * radius;
+    double t0 = c / q, t1 = q;
+    if (t0 > t1) std::swap(t0, t1);
+    const double t = t0 > 0.0 ? t0 : (t1 > 0.0 ? t1 : kNoHit);
+    if (t == kNoHit) return {};
+    const double off = margins::offAt(uncertainty, t, scale, kUnitRoundoff);
+    const double margin = margins::hitMargin(radius, std::sqrt(discriminant), off);
+    return {t, margin, t - margin, discriminant <= margins::discriminantMargin(radius, off)};
+}
+
+// Smallest root t > 0 of |o + t d|^2 = 1 for the unit sphere, given o and d in
+// the sphere's own frame (d not necessarily unit); kNoHit if none: the crossing
+// of an exact ray. `tolerance`: how far (object units) rounding may have put o
+// off the surface.
+inline double intersectUnitSphere(const glm::dvec3& o, const glm::dvec3& d, StartsOn start, double tolerance = 0.0) {
+    return crossUnitSphere(o, d, start, tolerance, {}, 0.0, 0.0).t;
 }
 
 // The same for a true sphere (centre, radius) and a unit direction: the unit
 // sphere's equation scaled by r, so a = 1 and o is relative to the centre.
 inline double intersectSphere(const glm::dvec3& centre, double radius, const Ray& ray, StartsOn start) {
-    const double tolerance = kRounding * (glm::length(ray.origin) + glm::length(centre) + radius);
-    const glm::dvec3 f = ray.origin - centre;
-    const double b = glm::dot(f, ray.direction);
-    if (start == StartsOn::Leaving) return kNoHit;
-    if (start == StartsOn::Entering) {
-        const double chord = -2.0 * b;
-        return chord > 0.0 ? chord : kNoHit;
-    }
-    const glm::dvec3 perpendicular = f - b * ray.direction;
-    const double discriminant = radius * radius - glm::dot(perpendicular, perpendicular);
-    if (discriminant < 0.0) return kNoHit;
-    if (std::abs(glm::length(f) - radius) <= tolerance) return b < 0.0 ? 0.0 : kNoHit;
-    const double q = -(b + std::copysign(std::sqrt(discriminant), b));
-    if (q == 0.0) return kNoHit;
-    const double c = glm::dot(f, f) - radius * radius;
-    double t0 = c / q, t1 = q;
-    if (t0 > t1) std::swap(t0, t1);
-    if (t0 > 0.0) return t0;
-    if (t1 > 0.0) return t1;
-    return kNoHit;
+    return crossSphere(centre, radius, ray, start, {}).t;
 }
 
 // Snell's law in the vector form of SPEC §4.5: for unit D and the shading

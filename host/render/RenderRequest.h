@@ -121,6 +121,14 @@ struct CostMap {
     }
 };
 
+// A pixel the GPU's float decisions left undecided (render/Margins.h), handed
+// to the CPU reference: where it is, and what the reference makes of it.
+struct RetracedPixel {
+    int x = 0, y = 0;
+    glm::dvec3 colour{0.0};
+    PixelTruncation truncation;
+};
+
 struct RenderRequest {
     Camera camera;
     int width = 0;
@@ -136,6 +144,12 @@ struct RenderRequest {
     // (0: all); the image is their mean. Progressive preview frames take one each.
     int firstSample = 0;
     int sampleCount = 0;
+    // The samples each pixel traces: sampleCount of the grid from firstSample.
+    int samplesTraced() const {
+        const int grid = std::max(1, supersample) * std::max(1, supersample);
+        const int first = std::clamp(firstSample, 0, grid - 1);
+        return sampleCount > 0 ? std::min(sampleCount, grid - first) : grid - first;
+    }
     TraceSettings trace;
     int threads = 0;  // 0: all hardware threads
     // Called now and then (from worker threads) with the fraction of pixels
@@ -164,16 +178,26 @@ struct RenderRequest {
     // When set, each pixel's estimated error where it has no finite bound and
     // one was made (PixelTruncation::estimatedError), else +inf, row-major.
     std::vector<float>* estimateImage = nullptr;
+    // When set, each pixel's decisions (row-major): 0 decided, 1 re-traced by
+    // the CPU reference where the GPU's were undecided, 2 undecided (widened).
+    std::vector<float>* decisionImage = nullptr;
     // The renderers' part in the two: sized for `pixels`, then pixel `at`.
     void startTruncationImages(std::size_t pixels) const {
         if (boundImage) boundImage->assign(pixels, 0.0f);
         if (estimateImage) estimateImage->assign(pixels, std::numeric_limits<float>::infinity());
+        if (decisionImage) decisionImage->assign(pixels, 0.0f);
     }
     void recordTruncation(std::size_t at, const PixelTruncation& p) const {
         if (boundImage) (*boundImage)[at] = float(p.bound);
         if (estimateImage)
             (*estimateImage)[at] = p.unbounded ? float(p.estimatedError) : std::numeric_limits<float>::infinity();
+        if (decisionImage) (*decisionImage)[at] = p.undecided ? 2.0f : p.retraced ? 1.0f : 0.0f;
     }
+    // When set (GPU renderer), the pixels whose decisions its float left
+    // undecided beyond what their bound may take are traced again by this (the
+    // CPU reference in double: reference/CpuRetrace.h), tile by tile; unset,
+    // their bound is widened to cover both outcomes.
+    std::function<void(std::vector<RetracedPixel>&)> retrace;
     // When set (GPU renderer), each pixel's rays (closest-hit queries of its
     // trees), row-major (width * height): its cost.
     std::vector<float>* rayImage = nullptr;

@@ -195,6 +195,8 @@ void TruncationReport::add(const PixelTruncation& p) {
     ++pixels;
     overTolerance += p.overTolerance;
     if (p.unbounded) ++unbounded;
+    undecided += p.undecided;
+    retraced += p.retraced;
     if (p.estimated) {
         ++estimated;
         maxEstimate = std::max(maxEstimate, p.estimatedError);
@@ -213,6 +215,8 @@ void TruncationReport::add(const PixelTruncation& p) {
 
 void TruncationReport::merge(const TruncationReport& o) {
     estimated += o.estimated;
+    undecided += o.undecided;
+    retraced += o.retraced;
     droppedGrowing += o.droppedGrowing;
     maxEstimate = std::max(maxEstimate, o.maxEstimate);
     maxBound = std::max(maxBound, o.maxBound);

@@ -131,6 +131,10 @@ struct PixelTruncation {
     // within the tolerance or not; the GPU reports those it stopped on only.
     double estimatedError = std::numeric_limits<double>::infinity();
     bool droppedGrowing = false;  // dropped light that may grow for want of room (the GPU's frontier or stack)
+    // A decision of its trees was within its rounding margin (render/Margins.h):
+    // its bound is widened to cover both outcomes, on both sides of the colour.
+    bool undecided = false;
+    bool retraced = false;        // the GPU's float decisions were undecided: re-traced by the CPU reference
 };
 
 // A render's truncation, summed over its pixels.
@@ -144,6 +148,8 @@ struct TruncationReport {
     std::uint64_t estimated = 0;     // unbounded pixels stopped by their estimated error (ErrorEstimate)
     std::uint64_t droppedGrowing = 0; // unbounded pixels, over the tolerance and unestimated, that dropped
                                       // light that may grow for want of room (the GPU's frontier or stack)
+    std::uint64_t undecided = 0;     // pixels whose bound covers an undecided decision (widened)
+    std::uint64_t retraced = 0;      // pixels the GPU left undecided, re-traced by the CPU reference
     double maxEstimate = 0.0;        // the largest estimated error of the estimated pixels
     int deepest = 0;                 // the deepest ray traced (generations below the primary ray)
     static constexpr std::size_t kExamples = 8;

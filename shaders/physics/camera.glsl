@@ -15,7 +15,9 @@ Ray cameraRay(uvec2 p, uint k) {
     rvec3 down = WIDE(frame.pixelDown, frameLow.pixelDown).xyz;
     rvec3 dir = normalize(corner + q.x * right + q.y * down);
     rvec4 primaryStart = WIDE(frame.primaryStart, frameLow.primaryStart);
-    return Ray(primaryStart.xyz + primaryStart.w * dir, dir, vec3(1.0), 0u, NONE, false, 0u, 0u);
+    rvec3 origin = primaryStart.xyz + primaryStart.w * dir;
+    rvec2 off = CHAIN * UNIT_ROUNDOFF * rvec2(length(origin), 1.0);
+    return Ray(origin, dir, vec3(1.0), 0u, NONE, false, 0u, 0u, off, false);
 }
 
 

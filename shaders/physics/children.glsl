@@ -11,6 +11,7 @@ struct Children {
     Ray refracted;   // where transmits; its medium stack the parent's crossed at the hit
                      // (crossSurface with removeAt, applied where it is traced or stored)
     bool transmits;  // a refracted ray exists (no total internal reflection)
+    bool undecided;  // total internal reflection or not is within its margin (margins.glsl)
     uint removeAt;   // leaving a sphere: where it is in the parent's medium stack (relativeIndex)
 };
 
@@ -29,7 +30,9 @@ Children children(Ray r, vec3 weight, Hit h) {
     vec3 reflectedGain = HAS_REFLECTION ? h.ks.rgb : vec3(0.0);
     vec3 reflectedWeight = min(weighted(weight, reflectedGain), vec3(MAX_WEIGHT));
     c.transmits = false;
+    c.undecided = false;
     rvec3 refracted = rvec3(0.0);
+    rvec2 refractedOff = rvec2(0.0);
     vec3 transmittedWeight = vec3(0.0);
     c.removeAt = r.mediaCount;
     vec4 kt = h.kt;
@@ -39,6 +42,7 @@ Children children(Ray r, vec3 weight, Hit h) {
         real eta = relativeIndex(r, h, c.removeAt);
         real cosIncident = -dot(n, d);
         real k = 1.0 - eta * eta * (1.0 - cosIncident * cosIncident);
+        if (DECISIONS) c.undecided = abs(k) <= reflectionMargin(eta, r.off.y + h.normalOff);
         if (k < 0.0) {
             // Total internal reflection is the reflected ray in the same medium:
             // one ray carries both weights.
@@ -46,11 +50,14 @@ Children children(Ray r, vec3 weight, Hit h) {
         } else {
             c.transmits = true;
             refracted = normalize(eta * d + (eta * cosIncident - sqrt(k)) * n);
+            if (DECISIONS) refractedOff = refractedOffset(r.off, h.pointOff, h.distance, h.rounding, h.turning, h.fromOutside, eta, k);
         }
     }
+    rvec2 reflectedOff = DECISIONS ? reflectedOffset(r.off, h.pointOff, h.distance, h.rounding, h.turning, h.fromOutside) : rvec2(0.0);
     c.reflected = Ray(h.point, d - 2.0 * dot(d, n) * n, reflectedWeight, r.depth + 1u, h.sphere, !h.fromOutside,
-                      r.mediaCount, 0u);
-    c.refracted = Ray(h.point, refracted, transmittedWeight, r.depth + 1u, h.sphere, h.fromOutside, r.mediaCount, 0u);
+                      r.mediaCount, 0u, reflectedOff, r.covered);
+    c.refracted = Ray(h.point, refracted, transmittedWeight, r.depth + 1u, h.sphere, h.fromOutside, r.mediaCount, 0u,
+                      refractedOff, r.covered);
     return c;
 }
 

@@ -24,6 +24,44 @@ real intersectSphere(uint index, rvec3 origin, real originLength, rvec3 dir, uin
     return intersectTrueSphere(anchor, normal, origin, originLength, dir, mode);
 }
 
+// The rivalry of a search (margins.glsl): the nearest crossing's margin and
+// whether it may be a miss, and the nearest any other sphere may be met by
+// the exact ray. The closest hit is undecided when that rival may come first.
+real bestMargin;
+bool bestGrazing;
+real rivalFrom;
+void beginSearch(rvec2 off) {
+    searchOff = off;
+    bestMargin = 0.0;
+    bestGrazing = false;
+    rivalFrom = NO_HIT;
+}
+// The crossing t of sphere i (just computed): nearer than tHit, it is the hit.
+void offer(real t, uint i, inout real tHit, inout uint hit) {
+    if (t < tHit) {
+        if (DECISIONS) {
+            rivalFrom = min(rivalFrom, tHit - bestMargin);
+            bestMargin = crossingMargin;
+            bestGrazing = crossingGrazing;
+        }
+        tHit = t;
+        hit = i;
+    } else if (DECISIONS) {
+        rivalFrom = min(rivalFrom, crossingRival);
+    }
+}
+// How far beyond the hit a box may hold a rival: twice the hit's margin
+// stands for the rival's own (CpuSearch.cpp, Rivalry::cull).
+real cullSlack() { return DECISIONS ? 2.0 * bestMargin : 0.0; }
+bool closestUndecided(real tHit) { return bestGrazing || (rivalFrom < NO_HIT && rivalFrom <= tHit + bestMargin); }
+// A visibility search that found `hit` (or none) before `distance`: a blocker
+// within its margin of either end or that may be a miss, or a near miss before
+// the light where none was found. (The search ends at the first blocker: one
+// unsure while a sure one lies further counts as undecided too.)
+bool blockUndecided(uint hit, real tHit, real distance) {
+    return hit != NONE ? bestGrazing || tHit + bestMargin >= distance : rivalFrom < distance;
+}
+
 // Word i of the BVH's nodes, through whichever the driver reads faster: the
 // texel view or the buffer's device address (shared_layout.h).
 uvec4 bvhWord(int i) {
@@ -63,9 +101,9 @@ uint queryBoxes(rvec3 origin, real originLength, rvec3 dir, uint fromSphere, uin
         walkLoopPass();
         uint i = uint(rayQueryGetIntersectionPrimitiveIndexEXT(query, false));
         real t = intersectSphere(i, origin, originLength, dir, fromSphere, start);
-        if (t < tHit) {
-            tHit = t;
-            hit = i;
+        bool nearer = t < tHit;
+        offer(t, i, tHit, hit);
+        if (nearer) {
             rayQueryGenerateIntersectionEXT(query, t);
             if (anyHit) rayQueryTerminateEXT(query);
         }
@@ -85,22 +123,20 @@ uint searchBvh(rvec3 origin, real originLength, rvec3 dir, uint fromSphere, uint
 }
 
 // SPEC §4.1: the closest hit with t > 0; returns the sphere index or NONE.
+// (Its margins: beginSearch, offer.)
 uint closestHit(rvec3 origin, rvec3 dir, uint fromSphere, uint start, out real tHit) {
     tHit = NO_HIT;
     real originLength = length(origin);
     if (USE_BVH) return searchBvh(origin, originLength, dir, fromSphere, start, false, tHit);
     uint hit = NONE;
     if (SPHERE_COUNT > 0u) {
-        [[unroll]] for (uint i = 0u; i < SPHERE_COUNT; ++i) {
-            real t = intersectSphere(i, origin, originLength, dir, fromSphere, start);
-            if (t < tHit) { tHit = t; hit = i; }
-        }
+        [[unroll]] for (uint i = 0u; i < SPHERE_COUNT; ++i)
+            offer(intersectSphere(i, origin, originLength, dir, fromSphere, start), i, tHit, hit);
         return hit;
     }
     for (uint i = 0u; i < frame.sphereCount; ++i) {
         sphereLoopPass();
-        real t = intersectSphere(i, origin, originLength, dir, fromSphere, start);
-        if (t < tHit) { tHit = t; hit = i; }
+        offer(intersectSphere(i, origin, originLength, dir, fromSphere, start), i, tHit, hit);
     }
     return hit;
 }
@@ -112,26 +148,35 @@ uint closestHit(rvec3 origin, rvec3 dir, uint fromSphere, uint start, out real t
 // first spares the search its answer. (Not where the spheres are unrolled: a
 // dynamic index into them costs more than it spares.)
 bool crossesOwnSphere(rvec3 origin, real originLength, rvec3 dir, real distance, uint fromSphere, uint start) {
-    return (USE_BVH || SPHERE_COUNT == 0u) && start == ENTERING &&
-           intersectSphere(fromSphere, origin, originLength, dir, fromSphere, start) < distance;
+    if (!((USE_BVH || SPHERE_COUNT == 0u) && start == ENTERING)) return false;
+    real t = intersectSphere(fromSphere, origin, originLength, dir, fromSphere, start);
+    // Only a sure crossing spares the search (margins.glsl).
+    return t < distance && (!DECISIONS || (!crossingGrazing && t + crossingMargin < distance));
 }
 
-bool occluded(rvec3 origin, rvec3 dir, real distance, uint fromSphere, uint start) {
+// off: how far the ray may be from the exact one; undecided: the exact ray's
+// answer may differ (blockUndecided).
+bool occluded(rvec3 origin, rvec3 dir, real distance, uint fromSphere, uint start, rvec2 off, out bool undecided) {
     real originLength = length(origin);
+    undecided = false;
+    beginSearch(off);
     if (crossesOwnSphere(origin, originLength, dir, distance, fromSphere, start)) return true;
-    if (USE_BVH) return searchBvh(origin, originLength, dir, fromSphere, start, true, distance) != NONE;
-    bool blocked = false;
-    if (SPHERE_COUNT > 0u) {
+    real tHit = distance;
+    uint hit = NONE;
+    if (USE_BVH) {
+        hit = searchBvh(origin, originLength, dir, fromSphere, start, true, tHit);
+    } else if (SPHERE_COUNT > 0u) {
         [[unroll]] for (uint i = 0u; i < SPHERE_COUNT; ++i) {
-            if (!blocked) blocked = intersectSphere(i, origin, originLength, dir, fromSphere, start) < distance;
+            if (hit == NONE) offer(intersectSphere(i, origin, originLength, dir, fromSphere, start), i, tHit, hit);
         }
-        return blocked;
+    } else {
+        for (uint i = 0u; i < frame.sphereCount && hit == NONE; ++i) {
+            sphereLoopPass();
+            offer(intersectSphere(i, origin, originLength, dir, fromSphere, start), i, tHit, hit);
+        }
     }
-    for (uint i = 0u; i < frame.sphereCount && !blocked; ++i) {
-        sphereLoopPass();
-        blocked = intersectSphere(i, origin, originLength, dir, fromSphere, start) < distance;
-    }
-    return blocked;
+    if (DECISIONS) undecided = blockUndecided(hit, tHit, distance);
+    return hit != NONE;
 }
 
 // 1–2. The closest hit of ray r (SPEC §4.1), and what shading needs there:
@@ -139,7 +184,9 @@ bool occluded(rvec3 origin, rvec3 dir, real distance, uint fromSphere, uint star
 // that resumes shading (resumeShading > 0) finds the same hit again.
 bool findHit(Ray r, out Hit h) {
     real t;
+    beginSearch(r.off);
     h.sphere = closestHit(r.origin, r.dir, r.fromSphere, r.inward ? ENTERING : LEAVING, t);
+    h.undecided = DECISIONS && closestUndecided(t);
     if (h.sphere == NONE) return false;
     uint material = sphereMaterial(h.sphere);
     h.kd = materialKd(material);
@@ -155,15 +202,27 @@ bool findHit(Ray r, out Hit h) {
     h.point = o + t * d;
     rvec4 anchor = sphereAnchor(h.sphere);
     rvec3 outward;
+    // How fast the normal turns as the point moves (CpuRenderer::outwardNormal).
     if (HAS_ELLIPSOIDS && anchor.w < 0.0) {
         rmat4 objectFromWorld = ellipsoidMatrix(uint(-anchor.w) - 1u);
         rvec3 p = (objectFromWorld * rvec4(o, 1.0)).xyz + t * (rmat3(objectFromWorld) * d);
-        outward = normalize(transpose(rmat3(objectFromWorld)) * p);
+        rmat3 m = rmat3(objectFromWorld);
+        rvec3 n = transpose(m) * p;
+        if (DECISIONS) h.turning = turningOf(transpose(m) * m, n);
+        outward = normalize(n);
     } else {
+        h.turning = 1.0 / anchor.w;
         outward = normalize(o - anchor.xyz + t * d + anchor.w * sphereNormal(h.sphere).xyz);
     }
-    h.fromOutside = dot(d, outward) < 0.0;
+    real facing = dot(d, outward);
+    h.fromOutside = facing < 0.0;
     h.normal = h.fromOutside ? outward : -outward;
+    // How sure: the point, its normal, and which side the ray came from.
+    h.distance = t;
+    h.rounding = CHAIN * UNIT_ROUNDOFF * (length(o) + t);
+    h.pointOff = bestMargin + h.rounding;
+    h.normalOff = normalOffset(h.pointOff, h.turning);
+    if (DECISIONS && abs(facing) <= facingMargin(r.off.y, h.normalOff)) h.undecided = true;
     return true;
 }
 

@@ -13,6 +13,7 @@ vec3 weighted(vec3 weight, vec3 colour) {
     bvec3 zero = bvec3(uvec3(equal(colour, vec3(0.0))) | uvec3(equal(weight, vec3(0.0))));
     return mix(weight * colour, vec3(0.0), zero);
 }
+float maxChannel(vec3 c) { return max(c.r, max(c.g, c.b)); }
 #define INFINITY uintBitsToFloat(0x7f800000u)
 // The largest weight a ray carries: an amplifying tree's weights grow without
 // end and would overflow to +inf (then inf · 0 = NaN). A capped weight is at
@@ -32,6 +33,8 @@ struct Ray {
     bool inward;      // it heads into that sphere
     uint mediaCount;  // its medium stack is `media`, innermost last
     uint resumeShading;  // 0: not shaded yet; k > 0: shading resumes at light k − 1
+    rvec2 off;        // how far it may be from the exact ray: its origin, its direction (margins.glsl)
+    bool covered;     // an undecided ancestor's light already covers its own
 };
 // The medium stack of the ray in hand, innermost last. Every access is in a
 // loop unrolled over MAX_MEDIA, so each entry has a constant index and the
@@ -53,6 +56,12 @@ struct Hit {
     rvec3 point;
     rvec3 normal;     // the shading normal N (against the ray)
     bool fromOutside; // the ray arrived from outside the sphere
+    real distance;    // t of the hit along the ray
+    real pointOff;    // how far the point and the normal may be from the exact ray's
+    real normalOff;   // (margins.glsl)
+    real rounding;    // the point's own rounding, and how fast the normal turns with it
+    real turning;
+    bool undecided;   // the exact ray may meet another surface, none, or this one from its other side
 };
 
 #endif

@@ -26,6 +26,7 @@ uint nthSetBit(uint x, uint n) {
 // for each invocation of the workgroup, by subgroup and lane.
 shared rvec4 sharedHitPoint[SNELL_WORKGROUP_SIZE];
 shared uint sharedHitSphere[SNELL_WORKGROUP_SIZE];
+shared real sharedHitOff[SNELL_WORKGROUP_SIZE];  // its pointOff (margins.glsl)
 uint sharedSlot(uint lane) { return gl_SubgroupID * gl_SubgroupSize + lane; }
 
 // The lights' part of the local term of a hit, the subgroup's shadow rays
@@ -58,6 +59,7 @@ void shadeLightsShared(inout SlotState state, Ray r, vec3 weight, Hit h, bool sh
     if (shading) {
         sharedHitPoint[sharedSlot(lane)] = rvec4(h.point, originLength);
         sharedHitSphere[sharedSlot(lane)] = h.sphere * 4u + start;
+        if (DECISIONS) sharedHitOff[sharedSlot(lane)] = h.pointOff;
     }
     subgroupMemoryBarrierShared();
     // The walkers: every lane still in the pixel loop, in lane order.
@@ -75,6 +77,7 @@ void shadeLightsShared(inout SlotState state, Ray r, vec3 weight, Hit h, bool sh
                 if (towardsLight(firstLight + b, h, l, distance) > 0.0) {
                     if (COUNT_RAYS) countedRays[SNELL_COUNTER_SHADOW]++;
                     shadowRays++;
+                    if (DECISIONS) beginSearch(shadowOff(h, distance));
                     walks = !crossesOwnSphere(h.point, originLength, l, distance, h.sphere, start);
                 }
             }
@@ -82,10 +85,10 @@ void shadeLightsShared(inout SlotState state, Ray r, vec3 weight, Hit h, bool sh
         }
         casting = subgroupOr(casting << (lane * batch));
         uint rays = uint(bitCount(casting));
-        uint walkedBlocked = 0u;
+        uint walkedBlocked = 0u, walkedUndecided = 0u;
         uint ray = walkerRank, bit = 0u, entry = 0u, depth = 0u, hit = NONE, fromSphere = 0u, fromStart = 0u;
         rvec3 origin = rvec3(0.0), l = rvec3(0.0), inverseDir = rvec3(0.0);
-        real distance = 0.0, rayOriginLength = 0.0;
+        real distance = 0.0, lightDistance = 0.0, rayOriginLength = 0.0;
         bool walking = ray < rays, begins = walking;
         while (walking) {
             if (begins) {
@@ -99,14 +102,20 @@ void shadeLightsShared(inout SlotState state, Ray r, vec3 weight, Hit h, bool sh
                 fromSphere = from >> 2;
                 fromStart = from & 3u;
                 distance = lightDirection(firstLight + bit % batch, origin, l);
+                lightDistance = distance;
                 inverseDir = safeInverse(l);
                 hit = NONE;
+                if (DECISIONS) {
+                    real pointOff = sharedHitOff[sharedSlot(bit / batch)];
+                    beginSearch(rvec2(pointOff, pointOff / distance + CHAIN * UNIT_ROUNDOFF));
+                }
             }
             if (COUNT_LANES) countLanes(true, walkSlots, walkBusy);
             walkPass(entry, depth, walking, distance, hit, origin, rayOriginLength, l, inverseDir, fromSphere,
                      fromStart, true);
             if (!walking) {
                 if (hit != NONE) walkedBlocked |= 1u << bit;
+                if (DECISIONS && blockUndecided(hit, distance, lightDistance)) walkedUndecided |= 1u << bit;
                 ray += walkers;
                 walking = begins = ray < rays;
                 entry = 0u;
@@ -114,16 +123,23 @@ void shadeLightsShared(inout SlotState state, Ray r, vec3 weight, Hit h, bool sh
             }
         }
         uint blocked = subgroupOr(walkedBlocked);
+        uint undecided = DECISIONS ? subgroupOr(walkedUndecided) : 0u;
         // Each lane's seen lights, in light order: those it cast a ray to
-        // (so its surface faces them) that nothing blocked.
+        // (so its surface faces them) that nothing blocked; where the answer
+        // is undecided, the light's term is either answer's (shadeLight).
         [[unroll]] for (uint b = 0u; b < 4u; ++b) {
             if (b >= batch) continue;
             uint mine = 1u << (lane * batch + b);
-            if ((casting & mine) == 0u || (blocked & mine) != 0u) continue;
+            if ((casting & mine) == 0u || ((blocked & mine) != 0u && (undecided & mine) == 0u)) continue;
             rvec3 toLight;
             real lightDistance;
             float nl = towardsLight(firstLight + b, h, toLight, lightDistance);
-            state.sum.rgb += weighted(weight, lightTerm(firstLight + b, h, toLight, nl, v));
+            vec3 error;
+            vec3 term = lightTerm(firstLight + b, h, toLight, nl, v, DECISIONS ? cosineOffset(h, lightDistance) : 0.0,
+                                  error);
+            if ((blocked & mine) == 0u) state.sum.rgb += weighted(weight, term);
+            if (DECISIONS && (blocked & mine) == 0u) state.shading += maxChannel(weighted(weight, error));
+            if ((undecided & mine) != 0u && !r.covered) state.undecided.a += maxChannel(weighted(weight, term));
         }
     }
 }
@@ -160,10 +176,13 @@ bool shadeLights(inout SlotState state, inout Ray r, vec3 weight, Hit h, bool sh
         tick(2u);  // this light, and the occlusion loop should no lane enter it
         if (shading && j + 1u >= r.resumeShading) {
             bool castShadowRay;
-            vec3 term = shadeLight(j, h, v, castShadowRay);
+            vec3 undecided = vec3(0.0), error = vec3(0.0);
+            vec3 term = shadeLight(j, h, v, castShadowRay, undecided, error);
             if (COUNT_RAYS && castShadowRay) countedRays[SNELL_COUNTER_SHADOW]++;
             if (castShadowRay) shadowRays++;
             state.sum.rgb += weighted(weight, term);
+            if (DECISIONS && !r.covered) state.undecided.a += maxChannel(weighted(weight, undecided));
+            if (DECISIONS) state.shading += maxChannel(weighted(weight, error));
         }
     }
     return false;

@@ -73,6 +73,8 @@ uint loadMedium(uint i) {
     return mediaStack[i];
 }
 
+const uint COVERED = 0x80000000u;  // PendingRay.flags: Ray.covered
+
 void storeRay(uint entry, Ray r) {
 #ifdef SNELL_FP64
     // The low entry holds the two lower parts of each double: origin and
@@ -86,15 +88,16 @@ void storeRay(uint entry, Ray r) {
 #else
     vec3 origin = r.origin, dir = r.dir;
 #endif
-    storePending(entry, PendingRay(vec4(origin, 0.0), vec4(dir, 0.0), vec4(r.weight, 0.0), r.depth, r.fromSphere,
-                                   (r.inward ? 1u : 0u) | (r.mediaCount << 1), r.resumeShading));
+    storePending(entry, PendingRay(vec4(origin, float(r.off.x)), vec4(dir, float(r.off.y)), vec4(r.weight, 0.0), r.depth,
+                                   r.fromSphere, (r.inward ? 1u : 0u) | (r.mediaCount << 1) | (r.covered ? COVERED : 0u),
+                                   r.resumeShading));
     [[unroll]] for (int k = 0; k < MAX_MEDIA; ++k)
         if (uint(k) < r.mediaCount) storeMedium(entry * uint(MAX_MEDIA) + uint(k), media[k]);
 }
 
 Ray loadRay(uint entry) {
     PendingRay p = loadPending(entry);
-    uint mediaCount = p.flags >> 1;
+    uint mediaCount = (p.flags & ~COVERED) >> 1;
     [[unroll]] for (int k = 0; k < MAX_MEDIA; ++k)
         if (uint(k) < mediaCount) media[k] = loadMedium(entry * uint(MAX_MEDIA) + uint(k));
 #ifdef SNELL_FP64
@@ -104,7 +107,8 @@ Ray loadRay(uint entry) {
 #else
     vec3 origin = p.origin.xyz, dir = p.direction.xyz;
 #endif
-    return Ray(origin, dir, p.weight.rgb, p.depth, p.fromSphere, (p.flags & 1u) != 0u, mediaCount, p.resumeShading);
+    return Ray(origin, dir, p.weight.rgb, p.depth, p.fromSphere, (p.flags & 1u) != 0u, mediaCount, p.resumeShading,
+               rvec2(p.origin.w, p.direction.w), (p.flags & COVERED) != 0u);
 }
 
 void pushRay(uint slot, inout uint pending, Ray r) {

@@ -10,8 +10,8 @@
 layout(set = 0, binding = SNELL_BINDING_OUTPUT, std430) writeonly buffer OutputBlock { OutputPixel outputPixels[]; };
 
 SlotState freshPixel(uint pixelIndex) {
-    return SlotState(vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0), vec4(INFINITY), vec4(0.0), pixelIndex, 0u, 0u, 0u,
-                     0u, 0u, 0u, 0u, 0u, 0u, 0u, 0u, firstCutOff, 0.0, INFINITY, INFINITY, 0.0, 0u, 0u, 0u);
+    return SlotState(vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0), vec4(INFINITY), vec4(0.0), vec4(0.0), pixelIndex, 0u, 0u, 0u,
+                     0u, 0u, 0u, 0u, 0u, 0u, 0u, 0u, firstCutOff, 0.0, INFINITY, INFINITY, 0.0, 0u, 0.0, 0u);
 }
 
 // What a step of a pixel proves of its exact colour: its colour is a lower
@@ -108,7 +108,8 @@ void finishPixel(uint slot, inout SlotState state, StepOutcome o, uint shadowRay
     outputPixels[state.pixel] = OutputPixel(
         vec4(state.lower.rgb, o.unbounded ? -o.bound : o.bound),
         vec4(o.settled && !dropped ? o.estimate : -1.0, float(state.overBudget),
-             dropped ? 2.0 : overTolerance ? 1.0 : 0.0, float(state.treeRays)));
+             dropped ? 2.0 : overTolerance ? 1.0 : 0.0, float(state.treeRays)),
+        state.undecided, vec4(state.shading, 0.0, 0.0, 0.0));
     uint finished = state.finished + 1u;
     uint rays = state.rays;
     state = freshPixel(takePixel());

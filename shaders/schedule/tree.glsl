@@ -84,6 +84,13 @@ bool followChildren(uint slot, inout SlotState state, inout Ray r, vec3 weight, 
     }
     noteGain(state, h, gain, weight);
     Children c = children(r, weight, h);
+    // Reflected or refracted within the margin: either answer's children
+    // carry light within their weights times R (margins.glsl).
+    if (DECISIONS && c.undecided && !r.covered) {
+        state.undecided.rgb += weighted(weight, gain);
+        c.reflected.covered = true;
+        c.refracted.covered = true;
+    }
     bool reflects = (HAS_REFLECTION || HAS_REFRACTION) && worthTracing(c.reflected.weight, tracingCutOff(state, cutOff));
     if (!reflects && (HAS_REFLECTION || HAS_REFRACTION)) deferRay(slot, state, c.reflected);
     // Asked after the reflected child waits: should it have filled the
