@@ -125,7 +125,12 @@ void readBackTile(const OutputPixel* pixels, const RenderRequest& request, const
             const bool any = out.undecided.r > 0.0f || out.undecided.g > 0.0f || out.undecided.b > 0.0f ||
                              out.undecided.a > 0.0f;
             const double shading = out.shading.x / double(samples);
-            const double moved = (undecided.bounded ? undecided.widening : undecided.guess) + shading;
+            // Where the pixel states an estimate, not a bound (light of a
+            // material that need not decay was left, or an undecided ray
+            // carries such light), what rounding may have moved is added to
+            // the estimate rather than re-traced.
+            const bool estimates = pixel.unbounded || !undecided.bounded;
+            const double moved = estimates ? 0.0 : undecided.widening + shading;
             if ((any || shading > 0.0) && request.retrace && !(moved <= retraceAbove(request))) {
                 RetracedPixel again;
                 again.x = imageX;
@@ -134,6 +139,7 @@ void readBackTile(const OutputPixel* pixels, const RenderRequest& request, const
                 continue;
             }
             if (any) widen(pixel, out, undecided, request.trace.tolerance);
+            if (pixel.unbounded && std::isfinite(pixel.estimatedError)) pixel.estimatedError += shading;
             pixel.bound = std::min(1.0, pixel.bound + shading + colourRounding(out, pixel, facts.lights));
             truncation.add(pixel);
             request.recordTruncation(std::size_t(windowRow) * area.width() + column, pixel);

@@ -21,7 +21,7 @@ namespace snell::margins {
 
 // Units of rounding an operation chain of the intersector or of shading may
 // take (a dot product of three terms and what follows it, with room).
-inline constexpr double kChain = 16.0;
+inline constexpr double kChain = 4.0;
 
 // How far a computed ray may be from the exact one.
 struct Uncertainty {

@@ -10,7 +10,7 @@
 // Off: no margins kept (the test kernels, and a kernel that measures their cost).
 layout(constant_id = SNELL_SPEC_DECISIONS) const bool DECISIONS = false;
 
-const real CHAIN = 16.0;  // units of rounding an operation chain may take (Margins.h, kChain)
+const real CHAIN = 4.0;  // units of rounding an operation chain may take (Margins.h, kChain)
 
 real offAt(rvec2 off, real t, real scale) { return off.x + off.y * t + CHAIN * UNIT_ROUNDOFF * (scale + t); }
 real discriminantMargin(real radius, real off) { return (2.0 * radius + off) * off; }
