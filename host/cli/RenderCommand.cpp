@@ -45,6 +45,7 @@ struct RenderOptions {
     std::optional<double> tolerance;
     std::optional<std::uint64_t> treeBudget;
     std::string boundImage;
+    std::string decisionMask;
     EncodingOptions encoding;
     std::vector<int> region;  // X0 Y0 X1 Y1, or empty
     bool allowRunaway = false;
@@ -118,6 +119,7 @@ private:
     // cost, and whether its tiles interleave.
     void estimateGpuCost(const Scene& scene, RenderRequest& request, ComputeRenderer& renderer, Progress& progress,
                          RenderOutcome& r, CostMap& expectedCost) const;
+    void writeDecisionMask(const RenderRequest& request, const std::vector<float>& decisions) const;
     void writeBoundImage(const RenderRequest& request, const std::vector<float>& bound,
                          const std::vector<float>& estimate) const;
     std::string statsJson(const Scene& scene, const RenderRequest& request, const RenderOutcome& r,
@@ -162,6 +164,11 @@ CLI::App* RenderCommand::define(CLI::App& app) {
                   "compare --bound-image: a certified bound, or where a pixel has none (ks + kt >= 1) but its error "
                   "was estimated, minus that estimate (.pfm or .exr keep it exact; .png shows magnitudes)")
         ->check(kImageFormat);
+    c->add_option("--decision-mask", o_.decisionMask,
+                  "Also write where rounding could decide the image to FILE: black where every decision was clear, "
+                  "grey where the GPU's float left one within its rounding and the CPU reference traced the pixel "
+                  "again in double, white where one stayed so and the bound covers both outcomes")
+        ->check(kImageFormat);
     addEncodingOptions(*c, o_.encoding);
     c->add_option("--region", o_.region,
                   "Render only pixels X0..X1-1, Y0..Y1-1 of the image, as an image of that window (for a "
@@ -195,12 +202,15 @@ int RenderCommand::run() {
     const std::string output = o_.output.empty() ? scene.name + ".png" : o_.output;
     checkWritable(output);
     if (!o_.boundImage.empty()) checkWritable(o_.boundImage);
+    if (!o_.decisionMask.empty()) checkWritable(o_.decisionMask);
     request.truncation = &truncation_;
     std::vector<float> bound, estimate;
     if (!o_.boundImage.empty()) {
         request.boundImage = &bound;
         request.estimateImage = &estimate;
     }
+    std::vector<float> decisions;
+    if (!o_.decisionMask.empty()) request.decisionImage = &decisions;
     request.cancel = interruptFlag();
     Progress progress(!o_.quiet);
     request.progress = progress.callback();
@@ -213,6 +223,7 @@ int RenderCommand::run() {
     if (interrupted()) throw Interrupted("no image written");
     stream.commit();
     if (!o_.boundImage.empty()) writeBoundImage(request, bound, estimate);
+    if (!o_.decisionMask.empty()) writeDecisionMask(request, decisions);
 
     if (!o_.quiet)
         for (const std::string& line : truncationMessages(truncation_, request.trace)) std::cerr << line << "\n";
@@ -400,6 +411,14 @@ RenderOutcome RenderCommand::renderOnGpu(const Scene& scene, RenderRequest& requ
         if (interrupted()) throw Interrupted("no image written");
         throw;
     }
+}
+
+void RenderCommand::writeDecisionMask(const RenderRequest& request, const std::vector<float>& decisions) const {
+    const PixelWindow area = request.area();
+    Image mask(area.width(), area.height());
+    for (std::size_t i = 0; i < decisions.size(); ++i)
+        for (int k = 0; k < 3; ++k) mask.rgb[i * 3 + k] = 0.5f * decisions[i];  // 0, 1 or 2
+    writeImage(o_.decisionMask, mask);
 }
 
 void RenderCommand::writeBoundImage(const RenderRequest& request, const std::vector<float>& bound,

@@ -73,28 +73,32 @@ Undecided undecidedOf(const OutputPixel& out, const RadianceBound& radiance, int
     return u;
 }
 
-// The pixel's bound widened to cover both outcomes, where there is one;
-// else it has none, and its estimate grows by the guess.
-void widen(PixelTruncation& pixel, const OutputPixel& out, const Undecided& u, double tolerance) {
+// The pixel's bound widened to cover both outcomes, where there is one. Else
+// a pixel that states an estimate keeps it, grown by the guess, while that is
+// within `small`; past it, the pixel has no bound but the clamp, and no
+// estimate (render/Truncation.h: TruncationReport::undecidedUnbounded).
+void widen(PixelTruncation& pixel, const OutputPixel& out, const Undecided& u, double small) {
     pixel.undecided = true;
     if (u.bounded) {
         pixel.bound = std::min(1.0, pixel.bound + u.widening);
         return;
     }
+    if (pixel.estimated && u.guess <= small) {
+        pixel.estimatedError += u.guess;
+        return;
+    }
     const double colour = std::min(1.0f, std::max({out.colour.r, out.colour.g, out.colour.b}));
     pixel.bound = std::max(pixel.bound, 1.0 - colour);
-    if (!pixel.unbounded) {
-        pixel.unbounded = true;
-        pixel.estimated = true;
-        pixel.estimatedError = u.guess;
-    } else if (pixel.estimated) {
-        pixel.estimatedError += u.guess;
-    }
-    if (pixel.estimated && pixel.estimatedError > tolerance && tolerance > 0.0) {
-        pixel.estimated = false;
-        pixel.overTolerance = true;
-    }
+    pixel.unbounded = true;
+    pixel.estimated = false;
+    pixel.estimatedError = std::numeric_limits<double>::infinity();
 }
+
+// Pixels whose trees traced more rays than this are not handed to the CPU
+// reference, whose time a ray is several of the kernel's: their bound is
+// widened instead (docs/accuracy.md, "Decisions"). Nor are pixels that state
+// an estimate, not a bound: the reference would only estimate them again.
+constexpr float kRetraceRays = 1024.0f;
 
 }  // namespace
 
@@ -125,21 +129,16 @@ void readBackTile(const OutputPixel* pixels, const RenderRequest& request, const
             const bool any = out.undecided.r > 0.0f || out.undecided.g > 0.0f || out.undecided.b > 0.0f ||
                              out.undecided.a > 0.0f;
             const double shading = out.shading.x / double(samples);
-            // Where the pixel states an estimate, not a bound (light of a
-            // material that need not decay was left, or an undecided ray
-            // carries such light), what rounding may have moved is added to
-            // the estimate rather than re-traced.
-            const bool estimates = pixel.unbounded || !undecided.bounded;
-            const double moved = estimates ? 0.0 : undecided.widening + shading;
-            if ((any || shading > 0.0) && request.retrace && !(moved <= retraceAbove(request))) {
+            const double moved = (undecided.bounded ? undecided.widening : undecided.guess) + shading;
+            if ((any || shading > 0.0) && request.retrace && !(moved <= retraceAbove(request)) &&
+                !pixel.unbounded && out.truncation.w <= kRetraceRays) {
                 RetracedPixel again;
                 again.x = imageX;
                 again.y = imageY;
                 retraced.push_back(again);
                 continue;
             }
-            if (any) widen(pixel, out, undecided, request.trace.tolerance);
-            if (pixel.unbounded && std::isfinite(pixel.estimatedError)) pixel.estimatedError += shading;
+            if (any) widen(pixel, out, undecided, retraceAbove(request));
             pixel.bound = std::min(1.0, pixel.bound + shading + colourRounding(out, pixel, facts.lights));
             truncation.add(pixel);
             request.recordTruncation(std::size_t(windowRow) * area.width() + column, pixel);

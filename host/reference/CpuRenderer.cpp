@@ -508,9 +508,8 @@ CpuRenderer::Pixel CpuRenderer::renderPixel(const RenderRequest& request, int x,
     // exact colour may lie on either side: the bound widens by that light
     // (Margins.h), and by the rounding of the sums and of the weights (each
     // at most `deepest` + lights + a few rounded factors or terms). Where R
-    // is infinite an undecided ray's light has no bound: the pixel has none,
-    // and its estimated error grows by that ray's weight times the most light
-    // one hit returns (as for light not traced, ErrorEstimate).
+    // is infinite an undecided ray's light has no bound: nor has the pixel,
+    // but the clamp, and it claims no estimate.
     pixel.undecided = tree.undecided;
     const double terms = tree.deepest + double(scene_.lights.size()) + 4.0;
     const double rounding =
@@ -521,11 +520,9 @@ CpuRenderer::Pixel CpuRenderer::renderPixel(const RenderRequest& request, int x,
         pixel.bound = std::min(1.0, pixel.bound + pixel.widening);
     } else {
         pixel.bound = std::max(pixel.bound, 1.0 - maxComponent(glm::min(pixel.colour, dvec3(1.0))));
-        const double guess = maxComponent(weighted(tree.undecidedWeight, radiance_.local) + tree.undecidedLight);
-        if (!pixel.unbounded || std::isfinite(pixel.estimatedError))
-            pixel.estimatedError = (pixel.unbounded ? pixel.estimatedError : 0.0) + guess / samples;
         pixel.unbounded = true;
-        pixel.overTolerance = pixel.overTolerance || pixel.estimatedError > settings.tolerance;
+        pixel.estimated = false;
+        pixel.estimatedError = std::numeric_limits<double>::infinity();
     }
     return pixel;
 }

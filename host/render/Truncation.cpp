@@ -205,7 +205,9 @@ void TruncationReport::add(const PixelTruncation& p) {
         ++droppedGrowing;
         if (droppedGrowingExamples.size() < kExamples) droppedGrowingExamples.push_back({p.x, p.y});
     }
-    if (p.unbounded && !p.estimated && !p.droppedGrowing && unsettledExamples.size() < kExamples)
+    const bool undecidedOnly = p.undecided && p.unbounded && !p.estimated && !p.droppedGrowing;
+    undecidedUnbounded += undecidedOnly;
+    if (p.unbounded && !p.estimated && !p.droppedGrowing && !undecidedOnly && unsettledExamples.size() < kExamples)
         unsettledExamples.push_back({p.x, p.y});
     if (p.overBudget) {
         ++overBudget;
@@ -216,6 +218,7 @@ void TruncationReport::add(const PixelTruncation& p) {
 void TruncationReport::merge(const TruncationReport& o) {
     estimated += o.estimated;
     undecided += o.undecided;
+    undecidedUnbounded += o.undecidedUnbounded;
     retraced += o.retraced;
     droppedGrowing += o.droppedGrowing;
     maxEstimate = std::max(maxEstimate, o.maxEstimate);

@@ -149,6 +149,7 @@ struct TruncationReport {
     std::uint64_t droppedGrowing = 0; // unbounded pixels, over the tolerance and unestimated, that dropped
                                       // light that may grow for want of room (the GPU's frontier or stack)
     std::uint64_t undecided = 0;     // pixels whose bound covers an undecided decision (widened)
+    std::uint64_t undecidedUnbounded = 0;  // of those, pixels left with no finite bound by that alone
     std::uint64_t retraced = 0;      // pixels the GPU left undecided, re-traced by the CPU reference
     double maxEstimate = 0.0;        // the largest estimated error of the estimated pixels
     int deepest = 0;                 // the deepest ray traced (generations below the primary ray)
@@ -161,8 +162,11 @@ struct TruncationReport {
     std::vector<std::array<int, 2>> droppedGrowingExamples;
 
     double meanBound() const { return pixels ? sumBound / double(pixels) : 0.0; }
-    // Unbounded pixels that neither claim an estimate nor dropped growing light.
-    std::uint64_t unsettled() const { return unbounded - std::min(unbounded, estimated + droppedGrowing); }
+    // Unbounded pixels that neither claim an estimate nor dropped growing light,
+    // nor have no bound only for a decision rounding may have flipped.
+    std::uint64_t unsettled() const {
+        return unbounded - std::min(unbounded, estimated + droppedGrowing + undecidedUnbounded);
+    }
     void add(const PixelTruncation& pixel);
     void merge(const TruncationReport& other);
 };

@@ -114,6 +114,15 @@ void budgetMessage(const TruncationReport& t, const TraceSettings& s, std::vecto
                   examples(t.overBudgetExamples, t.overBudget));
 }
 
+// Decisions that rounding could have flipped (render/Margins.h), where even
+// the arithmetic that settles them left them so.
+void decisionMessage(const TruncationReport& t, std::vector<std::string>& out) {
+    if (t.undecided == 0) return;
+    out.push_back("snell: note: " + std::to_string(t.undecided) + " pixel(s) met a decision that rounding may have "
+                  "flipped (which sphere is nearer, a hit or a miss, a shadow's edge, total internal reflection): "
+                  "their bound covers both outcomes (--decision-mask shows where)");
+}
+
 }  // namespace
 
 std::vector<std::string> truncationMessages(const TruncationReport& t, const TraceSettings& s) {
@@ -121,6 +130,7 @@ std::vector<std::string> truncationMessages(const TruncationReport& t, const Tra
     if (s.tolerance > 0.0) ladderMessages(t, s, out);
     else fixedTreeMessages(t, out);
     budgetMessage(t, s, out);
+    decisionMessage(t, out);
     if (t.droppedGrowing > 0)
         out.push_back("snell: warning: " + std::to_string(t.droppedGrowing) + " pixel(s) dropped light trapped in a "
                       "material with ks + kt > 1, which may grow, for want of room to keep it for their next step: "

@@ -1,0 +1,49 @@
+#!/usr/bin/env bash
+# Decisions that rounding can flip (render/Margins.h), one scene a kind:
+# scenes/hard/decide-*.scn put a decision of every kind (nearest hit, hit or
+# miss, inside or outside, total internal reflection, a shadow blocked)
+# within float32's rounding but 1e-9 clear in double, in a ring of pixels at
+# 32x32. In every pixel the GPU's render lies within its stated bound and the
+# CPU reference's of the reference (tests/stated_bound.py), and the GPU says
+# it traced pixels again in double; the decision mask marks them. A cut-off
+# by weight is decided either way within the bound (a ray not traced leaves
+# its weight times R in it): the CPU reference's bound covers the rounding of
+# its weights and sums, so even a pixel whose tree ended states one above 0.
+# shellcheck source=tests/cli_test_support.sh
+source "$(dirname "$0")/cli_test_support.sh"
+: "${PYTHON:=python3}"
+
+for scene in "$SCENES"/hard/decide-*.scn; do
+  name=$(basename "$scene" .scn)
+  if "$PYTHON" "$(dirname "$0")/stated_bound.py" --snell "$SNELL" --size 32 "$scene" >"$work/out" 2>&1; then ok
+  else bad "$name: a pixel beyond the stated bounds: $(grep -v '^$' "$work/out" | head -3)"; fi
+  "$SNELL" render "$scene" --size 32 -o "$work/$name.pfm" --decision-mask "$work/$name-mask.pfm" --stats -q \
+    >"$work/stats" 2>"$work/err"
+  retraced=$(grep -o '"retraced_pixels": [0-9]*' "$work/stats" | grep -o '[0-9]*$')
+  undecided=$(grep -o '"undecided_pixels": [0-9]*' "$work/stats" | grep -o '[0-9]*$')
+  # Found: traced again in double, or where even that cannot settle it (a
+  # pixel that only estimates its error), its bound widened.
+  [ $((${retraced:-0} + ${undecided:-0})) -gt 0 ] && ok ||
+    bad "$name: no decision found undecided: $(cat "$work/stats" "$work/err")"
+  "$PYTHON" - "$work/$name-mask.pfm" "${retraced:-0}" "${undecided:-0}" <<'PY' && ok ||
+import struct, sys
+with open(sys.argv[1], 'rb') as f:
+    f.readline(); f.readline(); f.readline()
+    values = f.read()
+marked = sum(1 for i in range(0, len(values) // 4, 3) if struct.unpack_from('<f', values, 4 * i)[0] > 0.0)
+sys.exit(0 if marked >= max(int(sys.argv[2]), int(sys.argv[3])) and marked > 0 else 1)
+PY
+    bad "$name: the decision mask does not mark the pixels found undecided"
+done
+
+# The CPU reference's bound covers its own rounding: basic.scn's trees end
+# (no light is left untraced), yet its pixels sum rounded terms, so none
+# states a bound of 0, nor more than rounding.
+"$SNELL" render "$SCENES/basic.scn" --cpu --size 16 -o "$work/m.pfm" --stats -q \
+  >"$work/stats" 2>&1
+mean=$(grep -o '"mean_bound": [0-9.e+-]*' "$work/stats" | grep -o '[0-9.e+-]*$')
+"$PYTHON" -c "import sys; sys.exit(0 if 0 < float('$mean') < 1e-9 else 1)" && ok ||
+  bad "the CPU reference's bound is not its rounding (mean bound ${mean:-none})"
+
+echo "decisions: $pass passed, $fail failed"
+[ "$fail" -eq 0 ]
