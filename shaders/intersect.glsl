@@ -142,7 +142,9 @@ real intersectTrueSphere(rvec4 anchorRadius, rvec4 normal, rvec3 origin, real or
     rvec3 g = origin - anchorRadius.xyz;
     real r = anchorRadius.w;
     real b = dot(g, dir) + r * dot(n0, dir);
-    real scale = originLength + normal.w + r;
+    // The rounding of g = o − P0 (the anchor keeps it near the surface): the
+    // scale of the point's and of t's rounding, however large the sphere.
+    real scale = originLength + normal.w;
     if (mode == ENTERING) {
         real chord = -2.0 * b;
         if (DECISIONS && chord > 0.0) {
