@@ -44,10 +44,10 @@ if [ "$step" != gpu ] && [[ " $scenes " == *" spheres "* ]]; then
   grep -c '^sphere' "$work/spheres.scn" | grep -qx 4000000 && ok || bad "the sphere scene does not hold 4 000 000 spheres"
 fi
 
-# Agreement as in the GPU tests, but with the ill-conditioned pixels counted:
-# at 32² nearly every pixel of the sphere scene is the silhouette of spheres
-# about a pixel across, whose hit or miss float and double may decide
-# differently (measured: 0.12-0.2 % of pixels), hence 0.5 % here.
+# Agreement with the CPU reference, every pixel counted: at 32² nearly every
+# pixel of the sphere scene is the silhouette of spheres about a pixel
+# across, whose hit or miss float and double may decide differently (0.12-0.2 %
+# of pixels before the GPU traced such pixels again in double), hence 0.5 %.
 for scene in $scenes; do
   if [ "$step" != gpu ]; then
     "$SNELL" render "$work/$scene.scn" --size 32 --cpu -q -o "$work/$scene-cpu.pfm" 2>"$work/err" && ok ||
