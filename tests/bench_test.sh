@@ -54,7 +54,7 @@ if "Mesa" not in d["driver"] and "llvmpipe" in d["device"]: fail.append(f"driver
 rows = list(csv.DictReader(open(os.path.join(out, "bench.csv"))))
 if len(rows) != len(d["results"]): fail.append("CSV and JSON disagree")
 scenes = {r["scene"] for r in d["results"]}
-expected = {"bench/simple", "bench/grid"} if part == "quick" else {"given/basic"}
+expected = {"bench/simple", "bench/grid"} if part == "quick" else {"scenes/basic"}
 if scenes != expected: fail.append(f"scenes {sorted(scenes)}, not {sorted(expected)}")
 for r in d["results"]:
     name = f'{r["scene"]} [{r["setting"]}]'

@@ -17,6 +17,16 @@ using namespace bench;
 
 namespace {
 
+// A scene's group, named by its folder: the bench scenes (which have peers)
+// and the course's by their shared names. Two scenes of one name in two
+// folders (bench/glass, scenes/glass) stay two rows.
+std::string groupOf(const fs::path& dir) {
+    fs::path folder = dir.lexically_normal();
+    if (folder.filename().empty()) folder = folder.parent_path();  // "scenes/"
+    const std::string name = folder.filename().string();
+    return name == "bench-scenes" ? "bench" : name == "course-scenes" ? "course" : name.empty() ? "given" : name;
+}
+
 std::vector<SceneFile> collectScenes(const BenchOptions& o) {
     std::vector<SceneFile> out;
     auto addDir = [&](const fs::path& dir, const std::string& group) {
@@ -29,11 +39,8 @@ std::vector<SceneFile> collectScenes(const BenchOptions& o) {
     };
     if (!o.scenes.empty()) {
         for (const std::string& s : o.scenes) {
-            if (fs::is_directory(s)) {
-                const std::string dir = fs::path(s).lexically_normal().filename().string();
-                addDir(s, dir == "bench-scenes" ? "bench" : dir == "course-scenes" ? "course" : dir);
-            }
-            else out.push_back({s, "given"});
+            if (fs::is_directory(s)) addDir(s, groupOf(s));
+            else out.push_back({s, groupOf(fs::absolute(s).parent_path())});
         }
         return out;
     }
