@@ -85,6 +85,8 @@ private:
                   const margins::Uncertainty& off, bool& undecided) const;
     Crossing intersect(std::uint32_t sphere, const Ray& ray, std::uint32_t fromSphere, StartsOn start,
                        const margins::Uncertainty& off) const;
+    template <class Reach, class Visit>
+    void eachCandidate(const Ray& ray, Reach reach, Visit visit) const;
 
 
     // growthTraps for a render's eye, kept for the next render from there.

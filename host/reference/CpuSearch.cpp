@@ -75,13 +75,15 @@ Crossing CpuRenderer::intersect(std::uint32_t index, const Ray& ray, std::uint32
     return crossUnitSphere(o, d, mode, tolerance, off, margins::acrossStretch(m, d), originLength);
 }
 
-CpuRenderer::Closest CpuRenderer::closestHit(const Ray& ray, std::uint32_t fromSphere, StartsOn start,
-                                             const margins::Uncertainty& off) const {
-    Rivalry search;
-    auto test = [&](std::uint32_t i) { search.offer(i, intersect(i, ray, fromSphere, start, off)); };
+// Offers `visit` every sphere the ray may meet before reach() (read at each
+// box: a search narrows it): all of them, or those whose BVH boxes it enters.
+// visit returns true to end the search.
+template <class Reach, class Visit>
+void CpuRenderer::eachCandidate(const Ray& ray, Reach reach, Visit visit) const {
     if (!useBvh_) {
-        for (std::uint32_t i = 0; i < scene_.spheres.size(); ++i) test(i);
-        return search.finish();
+        for (std::uint32_t i = 0; i < scene_.spheres.size(); ++i)
+            if (visit(i)) return;
+        return;
     }
     const dvec3 inverseDir = 1.0 / ray.direction;
     std::uint32_t stack[128];
@@ -89,14 +91,24 @@ CpuRenderer::Closest CpuRenderer::closestHit(const Ray& ray, std::uint32_t fromS
     stack[top++] = 0;
     while (top > 0) {
         const BvhNode& node = bvh_.nodes[stack[--top]];
-        if (!rayHitsBox(node.bounds, ray.origin, inverseDir, search.cull())) continue;
+        if (!rayHitsBox(node.bounds, ray.origin, inverseDir, reach())) continue;
         if (node.count > 0) {
-            for (std::uint32_t k = 0; k < node.count; ++k) test(bvh_.order[node.first + k]);
+            for (std::uint32_t k = 0; k < node.count; ++k)
+                if (visit(bvh_.order[node.first + k])) return;
         } else {
             stack[top++] = node.first;
             stack[top++] = node.first + 1;
         }
     }
+}
+
+CpuRenderer::Closest CpuRenderer::closestHit(const Ray& ray, std::uint32_t fromSphere, StartsOn start,
+                                             const margins::Uncertainty& off) const {
+    Rivalry search;
+    eachCandidate(ray, [&] { return search.cull(); }, [&](std::uint32_t i) {
+        search.offer(i, intersect(i, ray, fromSphere, start, off));
+        return false;
+    });
     return search.finish();
 }
 
@@ -107,15 +119,11 @@ bool CpuRenderer::occluded(const Ray& ray, double distance, std::uint32_t fromSp
     // either end, or a near miss before the light, leaves the answer
     // undecided, and the search goes on for a sure one.
     undecided = false;
-    bool blocked = false;
-    auto found = [&] {
-        undecided = false;
-        return true;
-    };
+    bool blocked = false, surelyBlocked = false;
     auto surely = [&](const Crossing& c) {
         if (c.t < distance) {
             blocked = true;
-            if (!c.grazing && c.t + c.margin < distance) return true;
+            if (!c.grazing && c.t + c.margin < distance) return surelyBlocked = true;
             undecided = true;
         } else if (c.rivalFrom < distance) {
             undecided = true;
@@ -125,27 +133,10 @@ bool CpuRenderer::occluded(const Ray& ray, double distance, std::uint32_t fromSp
     // A ray that starts on a sphere headed into it (shading a hit from inside)
     // crosses that sphere at its chord unless the light is nearer: that one
     // test first spares the search its answer.
-    if (start == StartsOn::Entering && surely(intersect(fromSphere, ray, fromSphere, start, off))) return found();
-    if (!useBvh_) {
-        for (std::uint32_t i = 0; i < scene_.spheres.size(); ++i)
-            if (surely(intersect(i, ray, fromSphere, start, off))) return found();
-        return blocked;
-    }
-    const dvec3 inverseDir = 1.0 / ray.direction;
-    std::uint32_t stack[128];
-    int top = 0;
-    stack[top++] = 0;
-    while (top > 0) {
-        const BvhNode& node = bvh_.nodes[stack[--top]];
-        if (!rayHitsBox(node.bounds, ray.origin, inverseDir, distance)) continue;
-        if (node.count > 0) {
-            for (std::uint32_t k = 0; k < node.count; ++k)
-                if (surely(intersect(bvh_.order[node.first + k], ray, fromSphere, start, off))) return found();
-        } else {
-            stack[top++] = node.first;
-            stack[top++] = node.first + 1;
-        }
-    }
+    if (!(start == StartsOn::Entering && surely(intersect(fromSphere, ray, fromSphere, start, off))))
+        eachCandidate(ray, [&] { return distance; },
+                      [&](std::uint32_t i) { return surely(intersect(i, ray, fromSphere, start, off)); });
+    if (surelyBlocked) undecided = false;
     return blocked;
 }
 
