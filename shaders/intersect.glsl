@@ -37,34 +37,41 @@ real rootsToHit(real b, real a, real c, real rootDiscriminant) {
     return near > 0.0 ? near : (far > 0.0 ? far : NO_HIT);
 }
 
-// How sure a crossing is (margins.glsl; host/render/Margins.h derives it),
-// for a sphere of radius `radius` (1 in an ellipsoid's frame), `off` how far
-// the ray may be from the exact one there, at the hit t of half-chord h.
-void crossingFound(real t, real radius, real halfChord, real off, real discriminant) {
-    crossingMargin = hitMargin(radius, halfChord, off);
-    crossingGrazing = discriminant <= discriminantMargin(radius, off);
-    crossingRival = t - crossingMargin;
-}
-// A miss at discriminant < 0, closest to the centre at t = closest: a near
-// miss may be a hit about there.
-void crossingMissed(real closest, real radius, real off, real discriminant) {
+// How sure a crossing is (margins.glsl; host/render/Margins.h derives it).
+// A miss (or a ray leaving the sphere it starts on), closest to the centre at
+// t = closest: a near miss may be a hit about there (nearMissFrom). Misses
+// are the common case: they leave the intersector at once (a branch, taken
+// where every lane of a SIMD row misses), and a near miss's square root is
+// behind a branch kept as one, as near misses are rare.
+void crossingMissed(real closest, real radius, real off, real discriminant, bool leaving) {
     real decides = discriminantMargin(radius, off);
-    if (discriminant > -decides && closest + off > 0.0) crossingRival = max(0.0, closest - sqrt(decides) - off);
+    bool nearMiss = !leaving && discriminant > -decides && closest + off > 0.0;
+    crossingRival = NO_HIT;
+    crossingGrazing = false;
+    [[dont_flatten]] if (nearMiss) crossingRival = nearMissFrom(closest, decides, off);
 }
-// Within rounding of a surface the ray does not start on (the band below):
-// heading in it meets it at once, heading out not; either may be wrong.
-void crossingNearSurface(real b) {
-    crossingGrazing = b < 0.0;
-    if (b >= 0.0) crossingRival = 0.0;
+// Otherwise the margins are worked out once, whichever case the intersector
+// took (entering at the chord, within rounding of the surface, or the roots),
+// so that a SIMD row whose lanes took different cases pays for one. The
+// crossing t (NO_HIT: none) of a sphere of radius `radius` (1 in an
+// ellipsoid's frame), found at half-chord halfChord, `off` how far the ray may
+// be from the exact one there; `along` turns the frame's distances into the
+// ray's parameter (1/|d|). Within rounding of the surface (`near`) the ray
+// may be on either side of it.
+void crossingFound(real t, real radius, real halfChord, real off, real discriminant, real along, bool entering,
+                   bool near) {
+    crossingMargin = hitMargin(radius, halfChord, off) * along;
+    bool found = t < NO_HIT;
+    crossingGrazing = found && (near || (entering ? t <= crossingMargin : discriminant <= discriminantMargin(radius, off)));
+    crossingRival = near ? 0.0 : found ? t - crossingMargin : NO_HIT;
 }
 
 // The unit sphere seen through objectFromWorld (an ellipsoid). matrixNorm is
 // the largest absolute row sum of its linear part, originLength |origin|: the
 // scales of the rounding in o (prepared once per ellipsoid and per ray).
 // How far across itself objectFromWorld (m) moves the ray's line for a world
-// offset of 1 (Margins.h, acrossStretch).
-real acrossStretch(rmat3 m, rvec3 objectDir) {
-    rvec3 u = normalize(objectDir);
+// offset of 1 (Margins.h, acrossStretch), u the unit direction in its frame.
+real acrossStretch(rmat3 m, rvec3 u) {
     real sum = 0.0;
     for (int column = 0; column < 3; ++column) {
         rvec3 across = m[column] - dot(u, m[column]) * u;
@@ -75,55 +82,43 @@ real acrossStretch(rmat3 m, rvec3 objectDir) {
 
 real intersectEllipsoid(rmat4 objectFromWorld, real matrixNorm, rvec3 origin, real originLength, rvec3 dir,
                         uint mode) {
-    if (DECISIONS) {
-        crossingRival = NO_HIT;
-        crossingGrazing = false;
-    }
-    if (mode == LEAVING) return NO_HIT;
     rvec3 o = (objectFromWorld * rvec4(origin, 1.0)).xyz;
     rvec3 d = rmat3(objectFromWorld) * dir;
     real a = dot(d, d);
     real b = dot(o, d);
-    // The margins (crossUnitSphere in host/reference/Intersect.h): how far the
-    // line may be from the exact one's in this frame near t, and in the world.
-    real lengthD = DECISIONS ? sqrt(a) : 1.0;
     real lengthO = length(o);
-    real stretch = DECISIONS ? acrossStretch(rmat3(objectFromWorld), d) : 0.0;
-    real own = CHAIN * UNIT_ROUNDOFF * (lengthO + 1.0);
-    if (mode == ENTERING) {
-        real chord = -2.0 * b / a;
-        if (DECISIONS && chord > 0.0) {
-            real world = offAt(searchOff, chord, originLength);
-            crossingFound(chord, 1.0, abs(b) / lengthD, stretch * world + own, 1.0);
-            crossingMargin = crossingMargin / lengthD + world;
-            crossingRival = chord - crossingMargin;
-            crossingGrazing = chord <= crossingMargin;
-        }
-        return chord > 0.0 ? chord : NO_HIT;
-    }
     rvec3 perpendicular = o - (b / a) * d;
     real discriminant = a * (1.0 - dot(perpendicular, perpendicular));
-    if (discriminant < 0.0) {
+    bool entering = mode == ENTERING;
+    // The margins (crossUnitSphere in host/reference/Intersect.h): how far the
+    // line may be from the exact one's in this frame near t, from the world's
+    // offset there, which also moves the hit along the ray.
+    real lengthD = DECISIONS ? sqrt(a) : 1.0;
+    real closest = -b / a;
+    real own = CHAIN * UNIT_ROUNDOFF * (lengthO + 1.0);
+    if (mode == LEAVING || (!entering && discriminant < 0.0)) {
         if (DECISIONS) {
-            real closest = -b / a;
-            real off = stretch * offAt(searchOff, max(closest, 0.0), originLength) + own;
-            crossingMissed(closest * lengthD, 1.0, off, discriminant / a);
+            real world = offAt(searchOff, max(closest, 0.0), originLength);
+            real off = acrossStretch(rmat3(objectFromWorld), d / lengthD) * world + own;
+            crossingMissed(closest * lengthD, 1.0, off, discriminant / a, mode == LEAVING);
             if (crossingRival < NO_HIT) crossingRival /= lengthD;
         }
         return NO_HIT;
     }
     // Rounding of o: of the origin through the matrix, and of the product.
-    if (abs(lengthO - 1.0) <= ROUNDING * (lengthO + 1.0 + matrixNorm * originLength)) {
-        if (DECISIONS) crossingNearSurface(b);
-        return b < 0.0 ? 0.0 : NO_HIT;
-    }
-    real root = sqrt(discriminant);
-    real t = rootsToHit(b, a, dot(o, o) - 1.0, root);
-    if (DECISIONS && t < NO_HIT) {
-        real world = offAt(searchOff, t, originLength);
-        crossingFound(t * lengthD, 1.0, root / lengthD, stretch * world + own, discriminant / a);
-        crossingMargin = crossingMargin / lengthD + world;
-        crossingRival = t - crossingMargin;
+    bool near = !entering && abs(lengthO - 1.0) <= ROUNDING * (lengthO + 1.0 + matrixNorm * originLength);
+    real root = sqrt(max(discriminant, 0.0));
+    real t;
+    if (entering) t = 2.0 * closest > 0.0 ? 2.0 * closest : NO_HIT;  // the chord
+    else if (near) t = b < 0.0 ? 0.0 : NO_HIT;
+    else t = rootsToHit(b, a, dot(o, o) - 1.0, root);
+    if (DECISIONS) {
+        real world = offAt(searchOff, t < NO_HIT ? t : max(closest, 0.0), originLength);
+        real off = acrossStretch(rmat3(objectFromWorld), d / lengthD) * world + own;
+        crossingFound(t, 1.0, (entering ? abs(b) : root) / lengthD, off, discriminant / a, 1.0 / lengthD, entering, near);
+        crossingMargin += world;
+        if (t < NO_HIT && !near) crossingRival = t - crossingMargin;
+        if (entering) crossingGrazing = t < NO_HIT && t <= crossingMargin;
     }
     return t;
 }
@@ -133,11 +128,6 @@ real intersectEllipsoid(rmat4 objectFromWorld, real matrixNorm, rvec3 origin, re
 // (anchorRadius.w); normal.w is |P0|, originLength |origin|.
 // With g = o − P0, f = o − centre = g + r n0 and c = |f|² − r² = |g|² + 2r n0·g.
 real intersectTrueSphere(rvec4 anchorRadius, rvec4 normal, rvec3 origin, real originLength, rvec3 dir, uint mode) {
-    if (DECISIONS) {
-        crossingRival = NO_HIT;
-        crossingGrazing = false;
-    }
-    if (mode == LEAVING) return NO_HIT;
     rvec3 n0 = normal.xyz;
     rvec3 g = origin - anchorRadius.xyz;
     real r = anchorRadius.w;
@@ -145,32 +135,28 @@ real intersectTrueSphere(rvec4 anchorRadius, rvec4 normal, rvec3 origin, real or
     // The rounding of g = o − P0 (the anchor keeps it near the surface): the
     // scale of the point's and of t's rounding, however large the sphere.
     real scale = originLength + normal.w;
-    if (mode == ENTERING) {
-        real chord = -2.0 * b;
-        if (DECISIONS && chord > 0.0) {
-            crossingFound(chord, r, abs(b), offAt(searchOff, chord, scale), r * r);
-            crossingGrazing = chord <= crossingMargin;
-        }
-        return chord > 0.0 ? chord : NO_HIT;
-    }
     rvec3 f = g + r * n0;
     rvec3 perpendicular = f - b * dir;
     real discriminant = r * r - dot(perpendicular, perpendicular);
-    if (discriminant < 0.0) {
-        if (DECISIONS) crossingMissed(-b, r, offAt(searchOff, max(-b, 0.0), scale), discriminant);
+    bool entering = mode == ENTERING;
+    if (mode == LEAVING || (!entering && discriminant < 0.0)) {
+        if (DECISIONS) crossingMissed(-b, r, offAt(searchOff, max(-b, 0.0), scale), discriminant, mode == LEAVING);
         return NO_HIT;
     }
     real c = dot(g, g) + 2.0 * r * dot(n0, g);
     // Within rounding of the surface: |c| / (|f| + r) (the distance to it) is
     // at most the rounding of g = o − P0, whose operands' scale bounds |g| too:
     // |o| + |P0| + |g| <= 2 (|o| + |P0|). No division, one square root.
-    if (abs(c) <= 2.0 * ROUNDING * (originLength + normal.w) * (length(f) + r)) {
-        if (DECISIONS) crossingNearSurface(b);
-        return b < 0.0 ? 0.0 : NO_HIT;
+    bool near = !entering && abs(c) <= 2.0 * ROUNDING * scale * (length(f) + r);
+    real root = sqrt(max(discriminant, 0.0));
+    real t;
+    if (entering) t = -2.0 * b > 0.0 ? -2.0 * b : NO_HIT;  // the chord
+    else if (near) t = b < 0.0 ? 0.0 : NO_HIT;
+    else t = rootsToHit(b, 1.0, c, root);
+    if (DECISIONS) {
+        real off = offAt(searchOff, t < NO_HIT ? t : max(-b, 0.0), scale);
+        crossingFound(t, r, entering ? abs(b) : root, off, discriminant, 1.0, entering, near);
     }
-    real root = sqrt(discriminant);
-    real t = rootsToHit(b, 1.0, c, root);
-    if (DECISIONS && t < NO_HIT) crossingFound(t, r, root, offAt(searchOff, t, scale), discriminant);
     return t;
 }
 

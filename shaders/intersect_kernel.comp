@@ -3,6 +3,7 @@
 // no-hit value) per case, as the float pair hi + lo.
 #version 460
 #extension GL_GOOGLE_include_directive : require
+#extension GL_EXT_control_flow_attributes : require
 #include "shared_layout.h"
 #include "kernel_layout.h"
 #include "intersect.glsl"

@@ -88,7 +88,7 @@ inline Crossing crossUnitSphere(const glm::dvec3& o, const glm::dvec3& d, Starts
         const double off = offAt(std::max(closest, 0.0));
         const double decides = a * margins::discriminantMargin(1.0, off);
         if (discriminant > -decides && closest + off / length > 0.0)
-            return {kNoHit, 0.0, std::max(0.0, closest - (std::sqrt(decides / a) + off) / length), false};
+            return {kNoHit, 0.0, margins::nearMissFrom(closest * length, decides / a, off) / length, false};
         return {};
     }
     if (std::abs(glm::length(o) - 1.0) <= tolerance) return nearSurface(b);
@@ -125,7 +125,7 @@ inline Crossing crossSphere(const glm::dvec3& centre, double radius, const Ray& 
         const double off = margins::offAt(uncertainty, std::max(-b, 0.0), scale, kUnitRoundoff);
         const double decides = margins::discriminantMargin(radius, off);
         if (discriminant > -decides && -b + off > 0.0)
-            return {kNoHit, 0.0, std::max(0.0, -b - std::sqrt(decides) - off), false};
+            return {kNoHit, 0.0, margins::nearMissFrom(-b, decides, off), false};
         return {};
     }
     if (std::abs(glm::length(f) - radius) <= tolerance) return nearSurface(b);

@@ -47,6 +47,13 @@ inline double discriminantMargin(double radius, double off) { return (2.0 * radi
 // off·r/h from the computed point, along the surface's normal over its cosine.
 inline double hitMargin(double radius, double halfChord, double off) { return off * radius / halfChord; }
 
+// Hit or miss, the other way: a near miss (its discriminant within the margin
+// above, `decides`) may be a hit of the exact ray, whose half-chord is then at
+// most √decides: no sooner than the closest approach less that and the offset.
+inline double nearMissFrom(double closest, double decides, double off) {
+    return std::max(0.0, closest - std::sqrt(decides) - off);
+}
+
 // Inside or outside (SPEC §4.2): the sign of D·No, with D off by `tilt` and No
 // by `normalOff`.
 inline double facingMargin(double tilt, double normalOff, double unit) { return tilt + normalOff + kChain * unit; }

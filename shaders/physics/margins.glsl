@@ -15,6 +15,7 @@ const real CHAIN = 4.0;  // units of rounding an operation chain may take (Margi
 real offAt(rvec2 off, real t, real scale) { return off.x + off.y * t + CHAIN * UNIT_ROUNDOFF * (scale + t); }
 real discriminantMargin(real radius, real off) { return (2.0 * radius + off) * off; }
 real hitMargin(real radius, real halfChord, real off) { return off * radius / halfChord; }
+real nearMissFrom(real closest, real decides, real off) { return max(0.0, closest - sqrt(decides) - off); }
 real facingMargin(real tilt, real normalOff) { return tilt + normalOff + CHAIN * UNIT_ROUNDOFF; }
 real reflectionMargin(real eta, real cosineOff) {
     return 2.0 * eta * eta * cosineOff + CHAIN * UNIT_ROUNDOFF * (1.0 + eta * eta);
