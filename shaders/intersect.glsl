@@ -45,10 +45,11 @@ real rootsToHit(real b, real a, real c, real rootDiscriminant) {
 // behind a branch kept as one, as near misses are rare.
 void crossingMissed(real closest, real radius, real off, real discriminant, bool leaving) {
     real decides = discriminantMargin(radius, off);
-    bool nearMiss = !leaving && discriminant > -decides && closest + off > 0.0;
     crossingRival = NO_HIT;
     crossingGrazing = false;
-    [[dont_flatten]] if (nearMiss) crossingRival = nearMissFrom(closest, decides, off);
+    [[dont_flatten]] if (discriminant + decides > 0.0) {
+        if (!leaving && closest + off > 0.0) crossingRival = nearMissFrom(closest, decides, off);
+    }
 }
 // Otherwise the margins are worked out once, whichever case the intersector
 // took (entering at the chord, within rounding of the surface, or the roots),
@@ -140,7 +141,14 @@ real intersectTrueSphere(rvec4 anchorRadius, rvec4 normal, rvec3 origin, real or
     real discriminant = r * r - dot(perpendicular, perpendicular);
     bool entering = mode == ENTERING;
     if (mode == LEAVING || (!entering && discriminant < 0.0)) {
-        if (DECISIONS) crossingMissed(-b, r, offAt(searchOff, max(-b, 0.0), scale), discriminant, mode == LEAVING);
+        // offAt at the closest approach, its sums in the order that leaves the
+        // ray's own terms common to every sphere of the search.
+        if (DECISIONS) {
+            real rayTerms = searchOff.x + CHAIN * UNIT_ROUNDOFF * originLength;
+            real perUnit = searchOff.y + CHAIN * UNIT_ROUNDOFF;
+            real off = rayTerms + CHAIN * UNIT_ROUNDOFF * normal.w + perUnit * max(-b, 0.0);
+            crossingMissed(-b, r, off, discriminant, mode == LEAVING);
+        }
         return NO_HIT;
     }
     real c = dot(g, g) + 2.0 * r * dot(n0, g);
