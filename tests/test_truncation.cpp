@@ -35,6 +35,24 @@ TEST(RadianceBound, GeometricSeriesOfTheLargestGain) {
     EXPECT_TRUE(b.finite());
 }
 
+TEST(RadianceBound, EachMaterialItsOwnSeries) {
+    // A bright diffuse floor, L = 0.1 * 0.9 + 1 * 0.9 = 0.99, g = 0; dim glass,
+    // L = 1 * 0.05 = 0.05, g = 0.05 + 0.9 = 0.95: R = max(B, 0.99, 0.05 / 0.05),
+    // not 0.99 / 0.05 (the largest L over the largest g's decay).
+    const snell::Scene s = parse(
+        "view 8 1\nbackground 0.2 0.2 0.2\nambient 0.1 0.1 0.1\nlight 1 1 1 0 0 5\n"
+        "material 0.9 0.9 0.9 0 0 0 1\nsphere\n"
+        "material 0 0 0 0.05 0.05 0.05 10\nrefraction 0.9 0.9 0.9 1.5\nmove 3 0 0\nsphere\n");
+    const snell::RadianceBound b = snell::radianceBound(s);
+    EXPECT_NEAR(b.local.x, 0.99, 1e-12);
+    EXPECT_NEAR(b.gain.x, 0.95, 1e-12);
+    EXPECT_NEAR(b.radiance.x, 1.0, 1e-9);
+    // Every ray's light within it: the floor's light alone, and the glass's
+    // own term plus its children's, at most 0.05 + 0.95 R.
+    EXPECT_GE(b.radiance.x, 0.99);
+    EXPECT_GE(b.radiance.x, 0.05 + 0.95 * b.radiance.x - 1e-12);
+}
+
 TEST(RadianceBound, InfiniteWhereLightNeedNotDecay) {
     const snell::Scene s = parse("view 8 1\nlight 1 1 1 0 0 5\nmaterial 0.5 0.5 0.5 0.5 0 0 10\n"
                                  "refraction 0.6 0 0 1.5\nsphere\n");

@@ -15,13 +15,19 @@ RadianceBound radianceBound(const Scene& scene) {
     b.local = scene.background;
     glm::dvec3 lights(0.0);
     for (const Light& light : scene.lights) lights += light.colour;
+    // The least R with R >= B and R >= L_m + g_m·R for every material m.
+    glm::dvec3 series = scene.background;
     for (const Material& m : scene.materials) {
-        b.local = glm::max(b.local, scene.ambient * m.kd + lights * (m.kd + m.ks));
-        b.gain = glm::max(b.gain, m.gain());
+        const glm::dvec3 local = scene.ambient * m.kd + lights * (m.kd + m.ks);
+        const glm::dvec3 gain = m.gain();
+        b.local = glm::max(b.local, local);
+        b.gain = glm::max(b.gain, gain);
+        for (int c = 0; c < 3; ++c)
+            if (gain[c] < 1.0) series[c] = std::max(series[c], local[c] / (1.0 - gain[c]));
     }
     for (int c = 0; c < 3; ++c) {
         if (b.local[c] == 0.0) b.radiance[c] = 0.0;  // no light in this channel at all
-        else if (b.gain[c] < 1.0) b.radiance[c] = b.local[c] / (1.0 - b.gain[c]);
+        else if (b.gain[c] < 1.0) b.radiance[c] = series[c];
         else b.radiance[c] = std::numeric_limits<double>::infinity();
     }
     return b;
