@@ -67,9 +67,6 @@ void crossingFound(real t, real radius, real halfChord, real off, real discrimin
     crossingRival = near ? 0.0 : found ? t - crossingMargin : NO_HIT;
 }
 
-// The unit sphere seen through objectFromWorld (an ellipsoid). matrixNorm is
-// the largest absolute row sum of its linear part, originLength |origin|: the
-// scales of the rounding in o (prepared once per ellipsoid and per ray).
 // How far across itself objectFromWorld (m) moves the ray's line for a world
 // offset of 1 (Margins.h, acrossStretch), u the unit direction in its frame.
 real acrossStretch(rmat3 m, rvec3 u) {
@@ -81,6 +78,9 @@ real acrossStretch(rmat3 m, rvec3 u) {
     return sqrt(sum);
 }
 
+// The unit sphere seen through objectFromWorld (an ellipsoid). matrixNorm is
+// the largest absolute row sum of its linear part, originLength |origin|: the
+// scales of the rounding in o (prepared once per ellipsoid and per ray).
 real intersectEllipsoid(rmat4 objectFromWorld, real matrixNorm, rvec3 origin, real originLength, rvec3 dir,
                         uint mode) {
     rvec3 o = (objectFromWorld * rvec4(origin, 1.0)).xyz;

@@ -36,6 +36,32 @@ PY
     bad "$name: the decision mask does not mark the pixels found undecided"
 done
 
+# Clear decisions stay decided: a ray that misses everything by far has no
+# rival, whatever a flat ellipsoid's frame does to distances (an ellipsoid's
+# "none" once became finite through its frame's scale, and every such ray
+# undecided). Only pixels near a silhouette may be found undecided.
+cat >"$work/flat.scn" <<'SCN'
+view 32 0.5
+light 1 1 1 -3 5 2
+material 0.6 0.6 0.5 0.3 0.3 0.3 10
+group
+move -0.6 0 -4
+scale 1 1 0.05
+rotate 60 1 0 0
+sphere
+groupend
+group
+move 0.8 0 -4
+scale 0.4 0.4 0.4
+sphere
+groupend
+SCN
+"$SNELL" render "$work/flat.scn" -o "$work/flat.pfm" --stats -q >"$work/stats" 2>"$work/err"
+retraced=$(grep -o '"retraced_pixels": [0-9]*' "$work/stats" | grep -o '[0-9]*$')
+undecided=$(grep -o '"undecided_pixels": [0-9]*' "$work/stats" | grep -o '[0-9]*$')
+[ -n "$retraced" ] && [ $((retraced + ${undecided:-0})) -le 64 ] && ok ||
+  bad "flat ellipsoid: ${retraced:-?} re-traced and ${undecided:-?} widened of 1024 pixels, most far from any edge"
+
 # The CPU reference's bound covers its own rounding: basic.scn's trees end
 # (no light is left untraced), yet its pixels sum rounded terms, so none
 # states a bound of 0, nor more than rounding.
