@@ -25,6 +25,7 @@ const uint LEAVING = 1u;
 const uint ENTERING = 2u;
 
 const real ROUNDING = 4.0 * UNIT_ROUNDOFF;  // 4 units of rounding
+const real SQRT3 = 1.7320509;  // √3, rounded up
 
 real rootsToHit(real b, real a, real c, real rootDiscriminant) {
     // q-form: q = −(b + sign(b)·√Δ); roots c/q and q/a, no cancellation.
@@ -38,18 +39,28 @@ real rootsToHit(real b, real a, real c, real rootDiscriminant) {
 }
 
 // How sure a crossing is (margins.glsl; host/render/Margins.h derives it).
-// A miss (or a ray leaving the sphere it starts on), closest to the centre at
-// t = closest: a near miss may be a hit about there (nearMissFrom). Misses
-// are the common case: they leave the intersector at once (a branch, taken
-// where every lane of a SIMD row misses), and a near miss's square root is
-// behind a branch kept as one, as near misses are rare.
-void crossingMissed(real closest, real radius, real off, real discriminant, bool leaving) {
-    real decides = discriminantMargin(radius, off);
+// Misses are the common case, and most are sure: past the surface by more
+// than the ray's offset may be (a radius widened by a bound on it, the
+// sphere's `reach`), they leave the intersector at once (a branch, taken
+// where every lane of a SIMD row misses). The widened test is a shortcut the
+// CPU reference does without: it passes on every near miss the exact test
+// below would find, and more, so no answer changes. A near miss, rare, is
+// behind a branch kept as one: closest to the centre at t = closest, it may
+// be a hit about there (nearMissFrom).
+bool surelyMissed(real reach, real across) {
+    // Widened by 16 units of rounding: the two tests' own rounding.
+    real widened = reach * (1.0 + 16.0 * UNIT_ROUNDOFF);
+    return widened * widened - across < 0.0;
+}
+real sureMiss() {
     crossingRival = NO_HIT;
     crossingGrazing = false;
-    [[dont_flatten]] if (discriminant + decides > 0.0) {
-        if (!leaving && closest + off > 0.0) crossingRival = nearMissFrom(closest, decides, off);
-    }
+    return NO_HIT;
+}
+void crossingMissed(real closest, real radius, real off, real discriminant) {
+    real decides = discriminantMargin(radius, off);
+    crossingGrazing = false;
+    crossingRival = discriminant + decides > 0.0 && closest + off > 0.0 ? nearMissFrom(closest, decides, off) : NO_HIT;
 }
 // Otherwise the margins are worked out once, whichever case the intersector
 // took (entering at the chord, within rounding of the surface, or the roots),
@@ -89,19 +100,25 @@ real intersectEllipsoid(rmat4 objectFromWorld, real matrixNorm, rvec3 origin, re
     real b = dot(o, d);
     real lengthO = length(o);
     rvec3 perpendicular = o - (b / a) * d;
-    real discriminant = a * (1.0 - dot(perpendicular, perpendicular));
+    real across = dot(perpendicular, perpendicular);
+    real discriminant = a * (1.0 - across);
     bool entering = mode == ENTERING;
     // The margins (crossUnitSphere in host/reference/Intersect.h): how far the
     // line may be from the exact one's in this frame near t, from the world's
     // offset there, which also moves the hit along the ray.
-    real lengthD = DECISIONS ? sqrt(a) : 1.0;
     real closest = -b / a;
     real own = CHAIN * UNIT_ROUNDOFF * (lengthO + 1.0);
-    if (mode == LEAVING || (!entering && discriminant < 0.0)) {
+    // A sure miss: √3 matrixNorm bounds acrossStretch (by the matrix's
+    // Frobenius norm), sparing its square roots. `world`: the world's offset
+    // at the closest approach (at the crossing, once one is found).
+    real world = DECISIONS ? offAt(searchOff, max(closest, 0.0), originLength) : 0.0;
+    if (mode == LEAVING || (!entering && surelyMissed(1.0 + SQRT3 * matrixNorm * world + own, across)))
+        return sureMiss();
+    real lengthD = DECISIONS ? sqrt(a) : 1.0;
+    [[dont_flatten]] if (!entering && discriminant < 0.0) {
         if (DECISIONS) {
-            real world = offAt(searchOff, max(closest, 0.0), originLength);
             real off = acrossStretch(rmat3(objectFromWorld), d / lengthD) * world + own;
-            crossingMissed(closest * lengthD, 1.0, off, discriminant / a, mode == LEAVING);
+            crossingMissed(closest * lengthD, 1.0, off, discriminant / a);
             if (crossingRival < NO_HIT) crossingRival /= lengthD;
         }
         return NO_HIT;
@@ -114,7 +131,7 @@ real intersectEllipsoid(rmat4 objectFromWorld, real matrixNorm, rvec3 origin, re
     else if (near) t = b < 0.0 ? 0.0 : NO_HIT;
     else t = rootsToHit(b, a, dot(o, o) - 1.0, root);
     if (DECISIONS) {
-        real world = offAt(searchOff, t < NO_HIT ? t : max(closest, 0.0), originLength);
+        if (t < NO_HIT) world = offAt(searchOff, t, originLength);
         real off = acrossStretch(rmat3(objectFromWorld), d / lengthD) * world + own;
         crossingFound(t, 1.0, (entering ? abs(b) : root) / lengthD, off, discriminant / a, 1.0 / lengthD, entering, near);
         crossingMargin += world;
@@ -138,17 +155,13 @@ real intersectTrueSphere(rvec4 anchorRadius, rvec4 normal, rvec3 origin, real or
     real scale = originLength + normal.w;
     rvec3 f = g + r * n0;
     rvec3 perpendicular = f - b * dir;
-    real discriminant = r * r - dot(perpendicular, perpendicular);
+    real across = dot(perpendicular, perpendicular);
+    real discriminant = r * r - across;
     bool entering = mode == ENTERING;
-    if (mode == LEAVING || (!entering && discriminant < 0.0)) {
-        // offAt at the closest approach, its sums in the order that leaves the
-        // ray's own terms common to every sphere of the search.
-        if (DECISIONS) {
-            real rayTerms = searchOff.x + CHAIN * UNIT_ROUNDOFF * originLength;
-            real perUnit = searchOff.y + CHAIN * UNIT_ROUNDOFF;
-            real off = rayTerms + CHAIN * UNIT_ROUNDOFF * normal.w + perUnit * max(-b, 0.0);
-            crossingMissed(-b, r, off, discriminant, mode == LEAVING);
-        }
+    if (mode == LEAVING || (!entering && surelyMissed(r + searchReach, across))) return sureMiss();
+    [[dont_flatten]] if (!entering && discriminant < 0.0) {
+        // offAt at the closest approach.
+        if (DECISIONS) crossingMissed(-b, r, offAt(searchOff, max(-b, 0.0), scale), discriminant);
         return NO_HIT;
     }
     real c = dot(g, g) + 2.0 * r * dot(n0, g);

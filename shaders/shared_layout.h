@@ -321,7 +321,7 @@ struct FrameParams {
     uint rayStackAddressHigh;   // SNELL_SPEC_STACKS_BY_ADDRESS), low and high 32 bits
     uint mediaStackAddressLow;
     uint mediaStackAddressHigh;
-    uint pad0;
+    float sphereExtent; // no true sphere's point lies farther from the origin (rounded up; physics/hit.glsl, beginSearch)
     uint pad1;
     uint pad2;
     // A scene of at most SNELL_FRAME_LIGHTS lights has them here again

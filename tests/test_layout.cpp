@@ -104,6 +104,7 @@ TEST(Layout, FrameParams) {
     EXPECT_EQ(offsetof(gpu::FrameParams, rayStackAddressHigh), 200u);
     EXPECT_EQ(offsetof(gpu::FrameParams, mediaStackAddressLow), 204u);
     EXPECT_EQ(offsetof(gpu::FrameParams, mediaStackAddressHigh), 208u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, sphereExtent), 212u);
 }
 
 TEST(Layout, TileParams) {
@@ -261,6 +262,12 @@ TEST(GpuScene, SmallSceneIsOriginRelativeAndClassified) {
     // Primary rays start at the origin's distance, from the eye (relative to it).
     EXPECT_FLOAT_EQ(f.primaryStart.w, static_cast<float>(g.primaryStart));
     EXPECT_NEAR(glm::length(glm::vec3(f.primaryStart) - rel(0, 0, 1)), 0.0f, 1e-6f);
+    // The true sphere's farthest point from the origin, rounded up (the
+    // shader's sure-miss test takes it as a bound on every true sphere's).
+    const double farthest = glm::length(snell::dvec3(1, 2, 3) - g.origin) + 2.0;
+    EXPECT_DOUBLE_EQ(g.sphereExtent, farthest);
+    EXPECT_GE(double(f.sphereExtent), farthest);
+    EXPECT_LE(double(f.sphereExtent), farthest * (1.0 + 1e-6));
 }
 
 TEST(GpuScene, AmplifyingMaterialFlagged) {

@@ -195,6 +195,7 @@ GpuScene buildGpuScene(const snell::Scene& scene, const snell::Camera& camera, P
             const snell::dvec3 anchor = centre + s.radius * n0;
             splitVec4(anchor, s.radius, g.anchorRadius, low.anchorRadius);
             splitVec4(n0, glm::length(anchor), g.normal, low.normal);
+            out.sphereExtent = std::max(out.sphereExtent, distance + s.radius);
         } else {
             // An ellipsoid: its index as −1 − e in w (shared_layout.h), its map's rows.
             const double e = static_cast<double>(out.ellipsoids.size());
@@ -265,6 +266,8 @@ FrameParams makeFrameParams(const snell::Scene& scene, const GpuScene& gpuScene,
     f.tolerance = float(trace.tolerance);
     f.amplifiedEstimate = float(snell::kAmplifiedEstimate);
     f.airEta = float(snell::kAirEta);
+    // Rounded up: the shader's bound on a true sphere's offsets (FrameParams.sphereExtent).
+    f.sphereExtent = std::nextafter(float(gpuScene.sphereExtent), std::numeric_limits<float>::infinity());
     f.imageWidth = static_cast<uint>(request.width);
     f.imageHeight = static_cast<uint>(request.height);
     f.supersample = static_cast<uint>(supersample);

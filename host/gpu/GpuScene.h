@@ -86,6 +86,7 @@ struct GpuScene {
     snell::dvec3 eye{0.0};       // the camera's eye
     snell::dvec3 origin{0.0};    // the world point that is the origin on the GPU
     double primaryStart = 0.0;   // distance from the eye at which primary rays start
+    double sphereExtent = 0.0;   // the farthest any true sphere's point lies from the origin
     int bvhDepth = 0;            // BVH nodes (of four children) on the longest root-to-leaf path
     // Entries the walk's stack needs: each node it enters leaves at most
     // all but one of its children waiting.

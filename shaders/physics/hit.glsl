@@ -30,11 +30,20 @@ real intersectSphere(uint index, rvec3 origin, real originLength, rvec3 dir, uin
 real bestMargin;
 bool bestGrazing;
 real rivalFrom;
-void beginSearch(rvec2 off) {
+// Its reach (margins.glsl): offAt where the ray passes closest to a true
+// sphere's centre, scaled by the sphere's anchor, is at most offAt with
+// FrameParams.sphereExtent for both (no true sphere's point lies farther from
+// the origin), the rounding of `along` added.
+void beginSearch(rvec2 off, rvec3 origin, real originLength, rvec3 dir) {
     searchOff = off;
     bestMargin = 0.0;
     bestGrazing = false;
     rivalFrom = NO_HIT;
+    if (DECISIONS) {
+        real extent = real(frame.sphereExtent);
+        real along = max(extent - dot(origin, dir), 0.0) + 4.0 * UNIT_ROUNDOFF * (extent + originLength);
+        searchReach = offAt(off, along, originLength + extent);
+    }
 }
 // The crossing t of sphere i (just computed): nearer than tHit, it is the hit.
 void offer(real t, uint i, inout real tHit, inout uint hit) {
@@ -123,10 +132,11 @@ uint searchBvh(rvec3 origin, real originLength, rvec3 dir, uint fromSphere, uint
 }
 
 // SPEC §4.1: the closest hit with t > 0; returns the sphere index or NONE.
-// (Its margins: beginSearch, offer.)
-uint closestHit(rvec3 origin, rvec3 dir, uint fromSphere, uint start, out real tHit) {
+// (Its margins, for a ray off by `off`: beginSearch, offer.)
+uint closestHit(rvec3 origin, rvec3 dir, uint fromSphere, uint start, rvec2 off, out real tHit) {
     tHit = NO_HIT;
     real originLength = length(origin);
+    beginSearch(off, origin, originLength, dir);
     if (USE_BVH) return searchBvh(origin, originLength, dir, fromSphere, start, false, tHit);
     uint hit = NONE;
     if (SPHERE_COUNT > 0u) {
@@ -159,7 +169,7 @@ bool crossesOwnSphere(rvec3 origin, real originLength, rvec3 dir, real distance,
 bool occluded(rvec3 origin, rvec3 dir, real distance, uint fromSphere, uint start, rvec2 off, out bool undecided) {
     real originLength = length(origin);
     undecided = false;
-    beginSearch(off);
+    beginSearch(off, origin, originLength, dir);
     if (crossesOwnSphere(origin, originLength, dir, distance, fromSphere, start)) return true;
     real tHit = distance;
     uint hit = NONE;
@@ -184,8 +194,7 @@ bool occluded(rvec3 origin, rvec3 dir, real distance, uint fromSphere, uint star
 // that resumes shading (resumeShading > 0) finds the same hit again.
 bool findHit(Ray r, out Hit h) {
     real t;
-    beginSearch(r.off);
-    h.sphere = closestHit(r.origin, r.dir, r.fromSphere, r.inward ? ENTERING : LEAVING, t);
+    h.sphere = closestHit(r.origin, r.dir, r.fromSphere, r.inward ? ENTERING : LEAVING, r.off, t);
     h.undecided = DECISIONS && closestUndecided(t);
     if (h.sphere == NONE) return false;
     uint material = sphereMaterial(h.sphere);

@@ -63,5 +63,9 @@ real crossingMargin;
 real crossingRival;
 bool crossingGrazing;
 rvec2 searchOff;
+// The most any true sphere's offset (offAt at its closest approach, scaled by
+// its anchor) may be in this search: beyond the radius by more, a miss is
+// sure (intersect.glsl). 0 without margins.
+real searchReach = 0.0;
 
 #endif

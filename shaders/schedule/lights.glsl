@@ -77,7 +77,7 @@ void shadeLightsShared(inout SlotState state, Ray r, vec3 weight, Hit h, bool sh
                 if (towardsLight(firstLight + b, h, l, distance) > 0.0) {
                     if (COUNT_RAYS) countedRays[SNELL_COUNTER_SHADOW]++;
                     shadowRays++;
-                    if (DECISIONS) beginSearch(shadowOff(h, distance));
+                    if (DECISIONS) beginSearch(shadowOff(h, distance), h.point, originLength, l);
                     walks = !crossesOwnSphere(h.point, originLength, l, distance, h.sphere, start);
                 }
             }
@@ -107,7 +107,7 @@ void shadeLightsShared(inout SlotState state, Ray r, vec3 weight, Hit h, bool sh
                 hit = NONE;
                 if (DECISIONS) {
                     real pointOff = sharedHitOff[sharedSlot(bit / batch)];
-                    beginSearch(rvec2(pointOff, pointOff / distance + CHAIN * UNIT_ROUNDOFF));
+                    beginSearch(rvec2(pointOff, pointOff / distance + CHAIN * UNIT_ROUNDOFF), origin, rayOriginLength, l);
                 }
             }
             if (COUNT_LANES) countLanes(true, walkSlots, walkBusy);
