@@ -62,6 +62,16 @@ undecided=$(grep -o '"undecided_pixels": [0-9]*' "$work/stats" | grep -o '[0-9]*
 [ -n "$retraced" ] && [ $((retraced + ${undecided:-0})) -le 64 ] && ok ||
   bad "flat ellipsoid: ${retraced:-?} re-traced and ${undecided:-?} widened of 1024 pixels, most far from any edge"
 
+# Where R is infinite, an undecided pixel has no bound but the clamp, on
+# either side of its colour: in becker-1n (a gain of 1.5 traps light) the
+# float tree of pixel (119, 56) at 128² grows an orbit to white where the
+# exact light is mostly blue, and its bound must say up to 1, not 1 − its
+# largest channel (0; nothing else covered it once a covered ray's shading
+# stopped adding its rounding).
+course="$SCENES/../../shared/course-scenes/becker-1n.scn"
+if "$PYTHON" "$(dirname "$0")/stated_bound.py" --snell "$SNELL" --size 128 "$course" >"$work/out" 2>&1; then ok
+else bad "becker-1n at 128²: a pixel beyond the stated bounds: $(grep -v '^$' "$work/out" | tail -3)"; fi
+
 # The CPU reference's bound covers its own rounding: basic.scn's trees end
 # (no light is left untraced), yet its pixels sum rounded terms, so none
 # states a bound of 0, nor more than rounding.

@@ -176,6 +176,16 @@ TEST(PixelEstimate, ClampedToTheHeadroomAndZeroWhenSaturated) {
     EXPECT_FALSE(g.unbounded());
 }
 
+// Where only the clamp bounds a pixel whose colour may lie on either side of
+// the exact one, each channel may be off by its distance to 0 or to 1: a
+// saturated white may be exactly a dark blue.
+TEST(ClampOnlyBound, EitherSideOfEveryChannel) {
+    EXPECT_EQ(snell::clampOnlyBound({1.0, 1.0, 1.0}), 1.0);
+    EXPECT_EQ(snell::clampOnlyBound({2.0, -1.0, 0.5}), 1.0);  // clamped first
+    EXPECT_NEAR(snell::clampOnlyBound({0.3, 0.5, 0.6}), 0.7, 1e-15);
+    EXPECT_NEAR(snell::clampOnlyBound({0.5, 0.5, 0.5}), 0.5, 1e-15);
+}
+
 TEST(PixelEstimate, KeepsTheBestOfEachAttempt) {
     snell::RadianceBound b;
     b.radiance = glm::dvec3(1.0, std::numeric_limits<double>::infinity(), 1.0);

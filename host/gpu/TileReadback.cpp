@@ -87,8 +87,7 @@ void widen(PixelTruncation& pixel, const OutputPixel& out, const Undecided& u, d
         pixel.estimatedError += u.guess;
         return;
     }
-    const double colour = std::min(1.0f, std::max({out.colour.r, out.colour.g, out.colour.b}));
-    pixel.bound = std::max(pixel.bound, 1.0 - colour);
+    pixel.bound = std::max(pixel.bound, clampOnlyBound(glm::dvec3(out.colour.r, out.colour.g, out.colour.b)));
     pixel.unbounded = true;
     pixel.estimated = false;
     pixel.estimatedError = std::numeric_limits<double>::infinity();

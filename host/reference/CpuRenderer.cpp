@@ -227,7 +227,10 @@ dvec3 CpuRenderer::outwardNormal(const Sphere& sphere, const Ray& ray, double t,
 // the material, the point, and the shading normal N. False on a miss.
 bool CpuRenderer::findHit(const PendingRay& r, Hit& hit) const {
     const StartsOn start = r.inward ? StartsOn::Entering : StartsOn::Leaving;
-    const Closest closest = closestHit(r.ray, r.fromSphere, start, r.off);
+    // A covered ray's light is already its ancestor's widening: its decisions
+    // count for nothing, so it keeps no offset (as the shader's findHit).
+    const margins::Uncertainty off = r.covered ? margins::Uncertainty{} : r.off;
+    const Closest closest = closestHit(r.ray, r.fromSphere, start, off);
     hit.t = closest.t;
     hit.sphere = closest.sphere;
     hit.undecided = closest.undecided;
@@ -246,7 +249,7 @@ bool CpuRenderer::findHit(const PendingRay& r, Hit& hit) const {
     hit.turning = turning;
     hit.pointOff = closest.margin + hit.rounding;
     hit.normalOff = margins::normalOff(hit.pointOff, turning, kUnitRoundoff);
-    if (std::abs(facing) <= margins::facingMargin(r.off.tilt, hit.normalOff, kUnitRoundoff)) hit.undecided = true;
+    if (std::abs(facing) <= margins::facingMargin(off.tilt, hit.normalOff, kUnitRoundoff)) hit.undecided = true;
     return true;
 }
 
@@ -310,6 +313,9 @@ CpuRenderer::Children CpuRenderer::children(const PendingRay& r, const Hit& hit,
     const dvec3 d = r.ray.direction;
     Children c;
     const margins::Hand hand{hit.pointOff, hit.t, hit.rounding, hit.turning, hit.fromOutside};
+    // Under a covered ray the children keep no offset either (findHit).
+    const bool keeps = !r.covered;
+    const margins::Uncertainty none{};
     dvec3 reflectedWeight = childWeight(r.weight, settings.reflection ? m.ks : dvec3(0.0));
     if (settings.refraction && m.refracts()) {
         const dvec3 transmittedWeight = childWeight(r.weight, m.kt);
@@ -326,13 +332,13 @@ CpuRenderer::Children CpuRenderer::children(const PendingRay& r, const Hit& hit,
         } else {
             c.refracted = PendingRay{{hit.point, refracted}, transmittedWeight, r.depth + 1, hit.sphere,
                                      hit.fromOutside, true, media,
-                                     margins::refracted(r.off, hand, eta, k, kUnitRoundoff),
+                                     keeps ? margins::refracted(r.off, hand, eta, k, kUnitRoundoff) : none,
                                      r.covered};
         }
     }
     c.reflected = PendingRay{{hit.point, reflectDirection(d, hit.normal)}, reflectedWeight, r.depth + 1, hit.sphere,
                              !hit.fromOutside, false, r.media,
-                             margins::reflected(r.off, hand, kUnitRoundoff), r.covered};
+                             keeps ? margins::reflected(r.off, hand, kUnitRoundoff) : none, r.covered};
     return c;
 }
 
@@ -519,7 +525,7 @@ CpuRenderer::Pixel CpuRenderer::renderPixel(const RenderRequest& request, int x,
     if (std::isfinite(pixel.widening)) {
         pixel.bound = std::min(1.0, pixel.bound + pixel.widening);
     } else {
-        pixel.bound = std::max(pixel.bound, 1.0 - maxComponent(glm::min(pixel.colour, dvec3(1.0))));
+        pixel.bound = std::max(pixel.bound, clampOnlyBound(pixel.colour));
         pixel.unbounded = true;
         pixel.estimated = false;
         pixel.estimatedError = std::numeric_limits<double>::infinity();

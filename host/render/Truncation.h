@@ -56,6 +56,16 @@ struct PixelEstimate {
     bool unbounded() const;
 };
 
+// The bound of a pixel that only the clamp bounds, its colour on either side
+// of the exact one (an undecided decision where R is infinite: the light of
+// either outcome may be anything): each clamped channel may be off by as much
+// as it lies from 0 or from 1, whichever is farther.
+inline double clampOnlyBound(const glm::dvec3& colour) {
+    const glm::dvec3 c = glm::clamp(colour, 0.0, 1.0);
+    const glm::dvec3 widest = glm::max(c, 1.0 - c);
+    return std::max({widest.r, widest.g, widest.b});
+}
+
 // The error of a pixel that cannot be certified (light dropped where it need
 // not decay), estimated after each step of the cut-off from how far the step
 // moved its colour and how the weight it has not traced yet (in channels not

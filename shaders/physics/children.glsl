@@ -35,6 +35,12 @@ Children children(Ray r, vec3 weight, Hit h) {
     rvec2 refractedOff = rvec2(0.0);
     vec3 transmittedWeight = vec3(0.0);
     c.removeAt = r.mediaCount;
+    // What both children inherit of the ray's and the hit's offsets
+    // (margins.glsl); nothing under a covered ray (physics/hit.glsl, findHit).
+    real normalOff = 0.0;
+    rvec2 handed = rvec2(0.0);
+    if (DECISIONS && !r.covered)
+        handed = handedDown(r.off, h.pointOff, h.distance, h.rounding, h.turning, h.fromOutside, normalOff);
     vec4 kt = h.kt;
     if (HAS_REFRACTION && max(kt.r, max(kt.g, kt.b)) > 0.0) {
         transmittedWeight = min(weighted(weight, kt.rgb), vec3(MAX_WEIGHT));
@@ -49,11 +55,12 @@ Children children(Ray r, vec3 weight, Hit h) {
             reflectedWeight = min(reflectedWeight + transmittedWeight, vec3(MAX_WEIGHT));
         } else {
             c.transmits = true;
-            refracted = normalize(eta * d + (eta * cosIncident - sqrt(k)) * n);
-            if (DECISIONS) refractedOff = refractedOffset(r.off, h.pointOff, h.distance, h.rounding, h.turning, h.fromOutside, eta, k);
+            real root = sqrt(k);
+            refracted = normalize(eta * d + (eta * cosIncident - root) * n);
+            if (DECISIONS) refractedOff = refractedOffset(handed, normalOff, eta, root);
         }
     }
-    rvec2 reflectedOff = DECISIONS ? reflectedOffset(r.off, h.pointOff, h.distance, h.rounding, h.turning, h.fromOutside) : rvec2(0.0);
+    rvec2 reflectedOff = DECISIONS ? reflectedOffset(handed, normalOff) : rvec2(0.0);
     c.reflected = Ray(h.point, d - 2.0 * dot(d, n) * n, reflectedWeight, r.depth + 1u, h.sphere, !h.fromOutside,
                       r.mediaCount, 0u, reflectedOff, r.covered);
     c.refracted = Ray(h.point, refracted, transmittedWeight, r.depth + 1u, h.sphere, h.fromOutside, r.mediaCount, 0u,

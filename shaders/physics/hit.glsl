@@ -194,7 +194,10 @@ bool occluded(rvec3 origin, rvec3 dir, real distance, uint fromSphere, uint star
 // that resumes shading (resumeShading > 0) finds the same hit again.
 bool findHit(Ray r, out Hit h) {
     real t;
-    h.sphere = closestHit(r.origin, r.dir, r.fromSphere, r.inward ? ENTERING : LEAVING, r.off, t);
+    // A covered ray's light is already its ancestor's widening (ray.glsl):
+    // its decisions count for nothing, so it keeps no offset.
+    rvec2 off = r.covered ? rvec2(0.0) : r.off;
+    h.sphere = closestHit(r.origin, r.dir, r.fromSphere, r.inward ? ENTERING : LEAVING, off, t);
     h.undecided = DECISIONS && closestUndecided(t);
     if (h.sphere == NONE) return false;
     uint material = sphereMaterial(h.sphere);
@@ -231,7 +234,7 @@ bool findHit(Ray r, out Hit h) {
     h.rounding = CHAIN * UNIT_ROUNDOFF * (length(o) + t);
     h.pointOff = bestMargin + h.rounding;
     h.normalOff = normalOffset(h.pointOff, h.turning);
-    if (DECISIONS && abs(facing) <= facingMargin(r.off.y, h.normalOff)) h.undecided = true;
+    if (DECISIONS && abs(facing) <= facingMargin(off.y, h.normalOff)) h.undecided = true;
     return true;
 }
 

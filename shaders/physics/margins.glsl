@@ -38,21 +38,18 @@ real turningOf(rmat3 a, rvec3 n) {
 // What a hit's children inherit (Margins.h, handedDown: on a convex surface,
 // met from outside, the normal turns with the point's whole offset; inside,
 // with its rounding, and the origin's offset is carried along the ray).
+// Worked out once for both children; `normal`: the normal's offset.
 rvec2 handedDown(rvec2 parent, real offset, real t, real rounding, real turning, bool convex, out real normal) {
     normal = normalOffset(convex ? offset : rounding, turning);
     return rvec2(convex ? offset : parent.x + parent.y * t + rounding, parent.y);
 }
-rvec2 reflectedOffset(rvec2 parent, real offset, real t, real rounding, real turning, bool convex) {
-    real normal;
-    rvec2 u = handedDown(parent, offset, t, rounding, turning, convex, normal);
-    u.y += 2.0 * normal + CHAIN * UNIT_ROUNDOFF;
-    return u;
+// The reflected child's (Margins.h, reflectedOffset), from what is handed down.
+rvec2 reflectedOffset(rvec2 handed, real normal) {
+    return rvec2(handed.x, handed.y + 2.0 * normal + CHAIN * UNIT_ROUNDOFF);
 }
-rvec2 refractedOffset(rvec2 parent, real offset, real t, real rounding, real turning, bool convex, real eta, real k) {
-    real normal;
-    rvec2 u = handedDown(parent, offset, t, rounding, turning, convex, normal);
-    u.y = eta * parent.y + (eta + eta * eta / sqrt(k)) * normal + CHAIN * UNIT_ROUNDOFF;
-    return u;
+// The refracted child's (Margins.h, refractedOffset), root = √k of Snell's law.
+rvec2 refractedOffset(rvec2 handed, real normal, real eta, real root) {
+    return rvec2(handed.x, eta * handed.y + (eta + eta * eta / root) * normal + CHAIN * UNIT_ROUNDOFF);
 }
 
 // What the intersector learns of the crossing it last returned, beside its t:

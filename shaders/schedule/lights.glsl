@@ -138,7 +138,7 @@ void shadeLightsShared(inout SlotState state, Ray r, vec3 weight, Hit h, bool sh
             vec3 term = lightTerm(firstLight + b, h, toLight, nl, v, DECISIONS ? cosineOffset(h, lightDistance) : 0.0,
                                   error);
             if ((blocked & mine) == 0u) state.sum.rgb += weighted(weight, term);
-            if (DECISIONS && (blocked & mine) == 0u) state.shading += maxChannel(weighted(weight, error));
+            if (DECISIONS && (blocked & mine) == 0u && !r.covered) state.shading += maxChannel(weighted(weight, error));
             if ((undecided & mine) != 0u && !r.covered) state.undecided.a += maxChannel(weighted(weight, term));
         }
     }
@@ -182,7 +182,7 @@ bool shadeLights(inout SlotState state, inout Ray r, vec3 weight, Hit h, bool sh
             if (castShadowRay) shadowRays++;
             state.sum.rgb += weighted(weight, term);
             if (DECISIONS && !r.covered) state.undecided.a += maxChannel(weighted(weight, undecided));
-            if (DECISIONS) state.shading += maxChannel(weighted(weight, error));
+            if (DECISIONS && !r.covered) state.shading += maxChannel(weighted(weight, error));
         }
     }
     return false;
