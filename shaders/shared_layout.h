@@ -257,7 +257,8 @@ struct SlotState {
     float settledWeight; // the weight the pixel had not traced after the last step, in channels under 1, per sample
     uint droppedGrowing; // 1: light that may grow was dropped for want of room (a full frontier or ray stack)
     float shading;       // the light shading's rounding may have moved, largest channel, over its samples
-    uint pad2;
+    float unsureLight;   // the light its sum holds that the exact tree's may not (covered rays', ray.glsl;
+                         // undecided shadow rays'), largest channel, over its samples
 };
 
 // What the shader writes for each pixel of a tile.
@@ -269,7 +270,7 @@ struct OutputPixel {
                       // w: the rays (closest-hit queries) its trees traced, its cost (RenderRequest::rayImage)
     vec4 undecided;   // SlotState::undecided, summed over its samples: its undecided decisions may change
                       // its colour either way by rgb times R (render/Truncation.h), plus a
-    vec4 shading;     // x: SlotState::shading (physics/shade.glsl, shadingError)
+    vec4 shading;     // x: SlotState::shading (physics/shade.glsl, shadingError); y: SlotState::unsureLight
 };
 
 // A ray waiting to be traced (SPEC §4 ray tree, depth first). Its medium stack

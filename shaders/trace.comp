@@ -134,8 +134,8 @@ void main() {
                 state.undecided.rgb += weight;
                 ray.covered = true;
             }
-            if (!shading) state.sum.rgb += weighted(weight, frame.background.rgb);
-            else if (ray.resumeShading == 0u) state.sum.rgb += weighted(weight, ambientTerm(h));
+            if (!shading) addLight(state, ray, weighted(weight, frame.background.rgb), false);
+            else if (ray.resumeShading == 0u) addLight(state, ray, weighted(weight, ambientTerm(h)), false);
             deepest = max(deepest, ray.depth);
         }
         hasRay = shading;

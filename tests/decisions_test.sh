@@ -72,6 +72,23 @@ course="$SCENES/../../shared/course-scenes/becker-1n.scn"
 if "$PYTHON" "$(dirname "$0")/stated_bound.py" --snell "$SNELL" --size 128 "$course" >"$work/out" 2>&1; then ok
 else bad "becker-1n at 128²: a pixel beyond the stated bounds: $(grep -v '^$' "$work/out" | tail -3)"; fi
 
+# SPEC §6 clamps: where a pixel stays white however its undecided decisions
+# and rounding went (its colour less the light that hangs on them still at
+# least 1 in every channel), they cannot reach the output. decide-shadow's
+# wall made white by its ambient term alone: its ring's shadow rays are as
+# undecided as there, yet no pixel is re-traced or widened, on the GPU or the
+# CPU reference, and every pixel lies within its stated bound.
+sed -e 's/^ambient 0.1 0.1 0.1/ambient 1.5 1.5 1.5/' "$SCENES/hard/decide-shadow.scn" >"$work/white.scn"
+if "$PYTHON" "$(dirname "$0")/stated_bound.py" --snell "$SNELL" --size 32 "$work/white.scn" >"$work/out" 2>&1; then ok
+else bad "white either way: a pixel beyond the stated bounds: $(grep -v '^$' "$work/out" | head -3)"; fi
+for backend in "" --cpu; do
+  "$SNELL" render "$work/white.scn" $backend --size 32 -o "$work/white.pfm" --stats -q >"$work/stats" 2>"$work/err"
+  retraced=$(grep -o '"retraced_pixels": [0-9]*' "$work/stats" | grep -o '[0-9]*$')
+  undecided=$(grep -o '"undecided_pixels": [0-9]*' "$work/stats" | grep -o '[0-9]*$')
+  [ "${retraced:-0}" -eq 0 ] && [ -n "$undecided" ] && [ "$undecided" -eq 0 ] && ok ||
+    bad "white either way (${backend:-gpu}): ${retraced:-?} re-traced, ${undecided:-?} widened: $(cat "$work/err")"
+done
+
 # The CPU reference's bound covers its own rounding: basic.scn's trees end
 # (no light is left untraced), yet its pixels sum rounded terms, so none
 # states a bound of 0, nor more than rounding.

@@ -186,6 +186,14 @@ TEST(ClampOnlyBound, EitherSideOfEveryChannel) {
     EXPECT_NEAR(snell::clampOnlyBound({0.5, 0.5, 0.5}), 0.5, 1e-15);
 }
 
+TEST(WhiteEitherWay, EveryChannelStillAtLeastOne) {
+    EXPECT_TRUE(snell::whiteEitherWay({1.5, 1.2, 1.1}, 0.05));
+    EXPECT_FALSE(snell::whiteEitherWay({1.5, 1.2, 1.1}, 0.2));  // blue may fall below 1
+    EXPECT_FALSE(snell::whiteEitherWay({1.5, 1.2, 0.9}, 0.0));  // blue is not white
+    EXPECT_FALSE(snell::whiteEitherWay({1.0, 1.0, 1.0}, 0.0));  // exactly 1 less the subtraction's rounding
+    EXPECT_TRUE(snell::whiteEitherWay({3.0, 3.0, 3.0}, 2.0 - 1e-9));
+}
+
 TEST(PixelEstimate, KeepsTheBestOfEachAttempt) {
     snell::RadianceBound b;
     b.radiance = glm::dvec3(1.0, std::numeric_limits<double>::infinity(), 1.0);

@@ -29,15 +29,26 @@ PixelTruncation truncationOf(const OutputPixel& out, int imageX, int imageY) {
 // Float's unit roundoff: the kernel's colours are float in either precision.
 constexpr double kFloatRoundoff = 0x1p-24;
 
-// What the kernel's float colour arithmetic may have rounded away: a sum of n
+// The relative rounding of the kernel's float colour arithmetic: a sum of n
 // terms >= 0 is within (n − 1)·u of its own value (Higham, "Accuracy and
 // Stability of Numerical Algorithms", §4.2); a pixel's terms are its rays'
 // (each with its lights), and each weight is a product of at most that many
 // factors.
+double sumRounding(const OutputPixel& out, std::size_t lights) {
+    return (double(out.truncation.w) + 4.0) * (double(lights) + 1.0) * kFloatRoundoff;
+}
+// What it may have rounded away of the clamped colour and its bound.
 double colourRounding(const OutputPixel& out, const PixelTruncation& pixel, std::size_t lights) {
-    const double terms = (double(out.truncation.w) + 4.0) * (double(lights) + 1.0);
     const double colour = std::max({out.colour.r, out.colour.g, out.colour.b, 0.0f});
-    return terms * kFloatRoundoff * (std::min(colour, 1.0) + pixel.bound);
+    return sumRounding(out, lights) * (std::min(colour, 1.0) + pixel.bound);
+}
+
+// What the pixel's float sum may hold beyond the exact one's (whiteEitherWay):
+// light the exact tree may not hold (covered rays', undecided shadow rays'),
+// shading's rounding (`shading`, per sample) and the sum's own at its value.
+double excessOf(const OutputPixel& out, double shading, int samples, std::size_t lights) {
+    const double colour = std::max({out.colour.r, out.colour.g, out.colour.b, 0.0f});
+    return double(out.shading.y) / samples + shading + sumRounding(out, lights) * colour;
 }
 
 // Above this, what a pixel's float decisions and shading may have got wrong
@@ -128,6 +139,14 @@ void readBackTile(const OutputPixel* pixels, const RenderRequest& request, const
             const bool any = out.undecided.r > 0.0f || out.undecided.g > 0.0f || out.undecided.b > 0.0f ||
                              out.undecided.a > 0.0f;
             const double shading = out.shading.x / double(samples);
+            // A pixel white whichever way its decisions went needs neither.
+            if ((any || shading > 0.0) &&
+                whiteEitherWay(glm::dvec3(out.colour.r, out.colour.g, out.colour.b),
+                               excessOf(out, shading, samples, facts.lights))) {
+                truncation.add(pixel);
+                request.recordTruncation(std::size_t(windowRow) * area.width() + column, pixel);
+                continue;
+            }
             const double moved = (undecided.bounded ? undecided.widening : undecided.guess) + shading;
             if ((any || shading > 0.0) && request.retrace && !(moved <= retraceAbove(request)) &&
                 !pixel.unbounded && out.truncation.w <= kRetraceRays) {

@@ -147,6 +147,16 @@ struct CpuRenderer::TreeTrace {
     dvec3 undecidedWeight{0.0};
     dvec3 undecidedLight{0.0};
     bool undecided = false;
+    // The light the pixel's sum holds that the exact tree's may not, largest
+    // channel (render/Truncation.h, whiteEitherWay): covered rays', and of
+    // the others' terms what the exact ones may lack.
+    double excess = 0.0;
+
+    // Ray r's light, added to the pixel's sum; `excess` of it as above.
+    void add(dvec3& pixelSum, const PendingRay& r, const dvec3& light, const dvec3& unsure) {
+        addWeighted(pixelSum, r.weight, light);
+        excess += maxComponent(weighted(r.weight, r.covered ? light : unsure));
+    }
 
     // Ray r's light below this point may be either outcome's.
     void widen(PendingRay& r, const dvec3& weight) {
@@ -282,10 +292,15 @@ dvec3 CpuRenderer::shadeLight(const Light& light, const Hit& hit, const dvec3& v
     if (undecided) {
         uncertain.light += term;
         uncertain.undecided = true;
+        if (!blocked) uncertain.excess += term;
     }
     const double cosineOff = 2.0 * (hit.normalOff + toLight.tilt) + margins::kChain * kUnitRoundoff;
     const double specularOff = rv > 0.0 ? specular * m.phong * cosineOff / rv : 0.0;
-    if (!blocked) uncertain.light += light.colour * (m.kd * cosineOff + m.ks * specularOff);
+    if (!blocked) {
+        const dvec3 error = light.colour * (m.kd * cosineOff + m.ks * specularOff);
+        uncertain.light += error;
+        uncertain.excess += error;
+    }
     return blocked ? dvec3(0.0) : term;
 }
 
@@ -429,12 +444,13 @@ void CpuRenderer::traceTree(const PendingRay& root, dvec3& pixelSum, double satu
         const bool met = findHit(r, hit);
         if (hit.undecided) tree.widen(r, r.weight);
         if (!met) {
-            addWeighted(pixelSum, r.weight, scene_.background);
+            tree.add(pixelSum, r, scene_.background, dvec3(0.0));
             continue;
         }
         // 3. The local Phong term with binary shadows.
         Uncertain uncertain;
-        addWeighted(pixelSum, r.weight, localTerm(hit, -r.ray.direction, settings, counts, uncertain));
+        const dvec3 local = localTerm(hit, -r.ray.direction, settings, counts, uncertain);
+        tree.add(pixelSum, r, local, uncertain.excess);
         if (!r.covered) tree.undecidedLight += weighted(r.weight, uncertain.light);
         tree.undecided = tree.undecided || uncertain.undecided;
         // 4–5. The children: reflection, and refraction through the medium stack.
@@ -516,13 +532,17 @@ CpuRenderer::Pixel CpuRenderer::renderPixel(const RenderRequest& request, int x,
     // at most `deepest` + lights + a few rounded factors or terms). Where R
     // is infinite an undecided ray's light has no bound: nor has the pixel,
     // but the clamp, and it claims no estimate.
-    pixel.undecided = tree.undecided;
     const double terms = tree.deepest + double(scene_.lights.size()) + 4.0;
     const double rounding =
         margins::kChain * kUnitRoundoff * terms * (maxComponent(glm::abs(pixel.colour)) + pixel.bound);
     const dvec3 spread = weighted(tree.undecidedWeight, radiance_.radiance) + tree.undecidedLight;
     pixel.widening = maxComponent(spread) / samples + rounding;
-    if (std::isfinite(pixel.widening)) {
+    // White whichever way its decisions went: the exact pixel is white too.
+    const bool white = whiteEitherWay(pixel.colour, tree.excess / samples + rounding);
+    pixel.undecided = tree.undecided && !white;
+    if (white) {
+        pixel.widening = 0.0;
+    } else if (std::isfinite(pixel.widening)) {
         pixel.bound = std::min(1.0, pixel.bound + pixel.widening);
     } else {
         pixel.bound = std::max(pixel.bound, clampOnlyBound(pixel.colour));

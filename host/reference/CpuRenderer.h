@@ -67,7 +67,8 @@ private:
     // What of a local term may be off: the light of shadow rays whose answer
     // is undecided, and shading's rounding (Margins.h).
     struct Uncertain {
-        glm::dvec3 light{0.0};
+        glm::dvec3 light{0.0};   // may be off either way
+        glm::dvec3 excess{0.0};  // of the term returned, what the exact term may lack (whiteEitherWay)
         bool undecided = false;
     };
     glm::dvec3 localTerm(const Hit& hit, const glm::dvec3& v, const TraceSettings& settings, RayCounts& counts,

@@ -13,18 +13,18 @@ using glm::dvec3;
 namespace {
 
 bool rayHitsBox(const Aabb& box, const dvec3& origin, const dvec3& inverseDir, double tMax) {
-    // Slab test; inverseDir components may be ±inf, which the min/max handle.
+    // Slab test, the near and far planes chosen by the direction's signs.
+    // Where the ray runs in a slab's plane (0 · ±inf) a distance is NaN,
+    // which the comparisons below ignore: the slab does not narrow it.
     double t0 = 0.0, t1 = tMax;
     for (int k = 0; k < 3; ++k) {
-        double a = (box.lower[k] - origin[k]) * inverseDir[k];
-        double b = (box.upper[k] - origin[k]) * inverseDir[k];
-        if (std::isnan(a) || std::isnan(b)) continue;  // origin on a slab plane, parallel ray
-        if (a > b) std::swap(a, b);
-        t0 = std::max(t0, a);
-        t1 = std::min(t1, b);
-        if (t0 > t1) return false;
+        const bool negative = inverseDir[k] < 0.0;
+        const double near = ((negative ? box.upper[k] : box.lower[k]) - origin[k]) * inverseDir[k];
+        const double far = ((negative ? box.lower[k] : box.upper[k]) - origin[k]) * inverseDir[k];
+        t0 = near > t0 ? near : t0;
+        t1 = far < t1 ? far : t1;
     }
-    return true;
+    return t0 <= t1;
 }
 
 // The nearest crossing offered so far, and the nearest any other sphere may be

@@ -66,6 +66,17 @@ inline double clampOnlyBound(const glm::dvec3& colour) {
     return std::max({widest.r, widest.g, widest.b});
 }
 
+// SPEC §6 clamps each channel to [0, 1]. Every term of a pixel's sum is >= 0,
+// so the exact colour is at least the computed one less what the computed sum
+// may hold that the exact one does not (`excess`: the light of rays below an
+// undecided decision, of undecided shadow rays, and rounding). Where that
+// still reaches 1 in every channel, the exact pixel is white as the computed
+// one is: no undecided decision and no rounding can reach the output. (The
+// subtraction's own rounding, relative 2^-53, is taken off the colour.)
+inline bool whiteEitherWay(const glm::dvec3& colour, double excess) {
+    return std::min({colour.r, colour.g, colour.b}) * (1.0 - 0x1p-50) - excess >= 1.0;
+}
+
 // The error of a pixel that cannot be certified (light dropped where it need
 // not decay), estimated after each step of the cut-off from how far the step
 // moved its colour and how the weight it has not traced yet (in channels not

@@ -137,7 +137,7 @@ void shadeLightsShared(inout SlotState state, Ray r, vec3 weight, Hit h, bool sh
             vec3 error;
             vec3 term = lightTerm(firstLight + b, h, toLight, nl, v, DECISIONS ? cosineOffset(h, lightDistance) : 0.0,
                                   error);
-            if ((blocked & mine) == 0u) state.sum.rgb += weighted(weight, term);
+            if ((blocked & mine) == 0u) addLight(state, r, weighted(weight, term), (undecided & mine) != 0u);
             if (DECISIONS && (blocked & mine) == 0u && !r.covered) state.shading += maxChannel(weighted(weight, error));
             if ((undecided & mine) != 0u && !r.covered) state.undecided.a += maxChannel(weighted(weight, term));
         }
@@ -180,7 +180,7 @@ bool shadeLights(inout SlotState state, inout Ray r, vec3 weight, Hit h, bool sh
             vec3 term = shadeLight(j, h, v, castShadowRay, undecided, error);
             if (COUNT_RAYS && castShadowRay) countedRays[SNELL_COUNTER_SHADOW]++;
             if (castShadowRay) shadowRays++;
-            state.sum.rgb += weighted(weight, term);
+            addLight(state, r, weighted(weight, term), maxChannel(undecided) > 0.0);
             if (DECISIONS && !r.covered) state.undecided.a += maxChannel(weighted(weight, undecided));
             if (DECISIONS && !r.covered) state.shading += maxChannel(weighted(weight, error));
         }

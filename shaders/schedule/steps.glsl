@@ -11,7 +11,7 @@ layout(set = 0, binding = SNELL_BINDING_OUTPUT, std430) writeonly buffer OutputB
 
 SlotState freshPixel(uint pixelIndex) {
     return SlotState(vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0), vec4(INFINITY), vec4(0.0), vec4(0.0), pixelIndex, 0u, 0u, 0u,
-                     0u, 0u, 0u, 0u, 0u, 0u, 0u, 0u, firstCutOff, 0.0, INFINITY, INFINITY, 0.0, 0u, 0.0, 0u);
+                     0u, 0u, 0u, 0u, 0u, 0u, 0u, 0u, firstCutOff, 0.0, INFINITY, INFINITY, 0.0, 0u, 0.0, 0.0);
 }
 
 // What a step of a pixel proves of its exact colour: its colour is a lower
@@ -109,7 +109,7 @@ void finishPixel(uint slot, inout SlotState state, StepOutcome o, uint shadowRay
         vec4(state.lower.rgb, o.unbounded ? -o.bound : o.bound),
         vec4(o.settled && !dropped ? o.estimate : -1.0, float(state.overBudget),
              dropped ? 2.0 : overTolerance ? 1.0 : 0.0, float(state.treeRays)),
-        state.undecided, vec4(state.shading, 0.0, 0.0, 0.0));
+        state.undecided, vec4(state.shading, state.unsureLight, 0.0, 0.0));
     uint finished = state.finished + 1u;
     uint rays = state.rays;
     state = freshPixel(takePixel());

@@ -29,6 +29,14 @@ bool nextRay(uint slot, inout SlotState state, uvec2 pixel, out Ray ray) {
     return false;
 }
 
+// Light ray r returns, added to its pixel. Light the exact tree may not hold
+// (a covered ray's, ray.glsl; an undecided shadow ray's, `unsure`) is also
+// kept apart, its largest channel (host/gpu/TileReadback.cpp, whiteEitherWay).
+void addLight(inout SlotState state, Ray r, vec3 light, bool unsure) {
+    state.sum.rgb += light;
+    if (DECISIONS && (r.covered || unsure)) state.unsureLight += maxChannel(light);
+}
+
 // Ray r of the pixel, before its closest hit: under the cut-off it waits in
 // the frontier, past the tree budget it is lost; else it is traced, with
 // `weight` (the channels an amplifying pixel has saturated dropped). A ray
