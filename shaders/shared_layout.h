@@ -261,17 +261,30 @@ struct SlotState {
                          // undecided shadow rays'), largest channel, over its samples
 };
 
-// What the shader writes for each pixel of a tile.
+// What the shader writes for each pixel of a tile: 32 bytes, what the host
+// needs and no more. Each byte is written by the kernel and read again by the
+// host: at 64 bytes (the undecided weights and rounding terms as they were
+// summed, the host working out the rest) the dispatch of a scene of a few
+// spheres took 1.05-1.2x as long on lavapipe (docs/performance-log.md).
 struct OutputPixel {
-    vec4 colour;      // rgb: the colour (unclamped); a: its truncation bound, negative where not finite
-    vec4 truncation;  // x: the estimated error where it stopped on one (render/Truncation.h), else −1;
-                      // y: 1 where the tree budget stopped it; z: 1 where it ended over the tolerance,
-                      // 2 where that is because light that may grow was dropped (SlotState::droppedGrowing);
-                      // w: the rays (closest-hit queries) its trees traced, its cost (RenderRequest::rayImage)
-    vec4 undecided;   // SlotState::undecided, summed over its samples: its undecided decisions may change
-                      // its colour either way by rgb times R (render/Truncation.h), plus a
-    vec4 shading;     // x: SlotState::shading (physics/shade.glsl, shadingError); y: SlotState::unsureLight
+    vec4 colour;    // rgb: the colour (unclamped); a: its truncation bound, negative where not finite
+    float estimate; // the estimated error where it stopped on one (render/Truncation.h), else −1
+    uint report;    // SNELL_PIXEL_* flags, and above them the rays (closest-hit queries) its trees
+                    // traced, its cost (RenderRequest::rayImage)
+    float excess;   // the light its colour holds that the exact one may not: covered rays', undecided
+                    // shadow rays' (SlotState::unsureLight) and shading's rounding, a sample's mean
+    float moved;    // what its undecided decisions and shading's rounding may have moved of its colour:
+                    // their rays' weight times R (where R is not finite in a weighted channel, the
+                    // most one hit returns), their shadow rays' light, SlotState::shading; a sample's mean
 };
+// OutputPixel::report's flags.
+#define SNELL_PIXEL_OVER_BUDGET 1u          // the tree budget stopped it
+#define SNELL_PIXEL_OVER_TOLERANCE 2u       // it ended over the tolerance
+#define SNELL_PIXEL_DROPPED_GROWING 4u      // because light that may grow was dropped (SlotState::droppedGrowing)
+#define SNELL_PIXEL_UNDECIDED 8u            // a decision of its trees was within its margin (physics/margins.glsl)
+#define SNELL_PIXEL_MOVED_UNBOUNDED 16u     // and R is not finite in a channel its undecided rays weigh
+#define SNELL_PIXEL_RAYS_SHIFT 5u
+#define SNELL_PIXEL_RAYS_LIMIT 0x7ffffffu   // more rays than this are reported as this
 
 // A ray waiting to be traced (SPEC §4 ray tree, depth first). Its medium stack
 // is kept beside it in the media buffer.

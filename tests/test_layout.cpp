@@ -134,9 +134,11 @@ TEST(Layout, SlotStateAndPendingRay) {
     EXPECT_EQ(offsetof(gpu::SlotState, lastMove), 168u);
     EXPECT_EQ(offsetof(gpu::SlotState, moveBefore), 172u);
     EXPECT_EQ(offsetof(gpu::SlotState, settledWeight), 176u);
-    EXPECT_EQ(sizeof(gpu::OutputPixel), 64u);
-    EXPECT_EQ(offsetof(gpu::OutputPixel, truncation), 16u);
-    EXPECT_EQ(offsetof(gpu::OutputPixel, undecided), 32u);
+    EXPECT_EQ(sizeof(gpu::OutputPixel), 32u);
+    EXPECT_EQ(offsetof(gpu::OutputPixel, estimate), 16u);
+    EXPECT_EQ(offsetof(gpu::OutputPixel, report), 20u);
+    EXPECT_EQ(offsetof(gpu::OutputPixel, excess), 24u);
+    EXPECT_EQ(offsetof(gpu::OutputPixel, moved), 28u);
     EXPECT_EQ(sizeof(gpu::PendingRay), 64u);
     EXPECT_EQ(offsetof(gpu::PendingRay, weight), 32u);
     EXPECT_EQ(offsetof(gpu::PendingRay, depth), 48u);

@@ -107,7 +107,7 @@ GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool count
         const int bandRows = plan.bandRows();
         Image band = request.rowSink ? Image(area.width(), bandRows) : Image();
         const auto* pixels = static_cast<const gpu::OutputPixel*>(k.output.mapped);
-        const gpu::SceneFacts facts{scene_.lights.size(), radianceBound(scene_)};
+        const gpu::SceneFacts facts{scene_.lights.size()};
         gpu::RenderProgress progress;
         for (int ty = 0; ty < plan.tilesY; ++ty) {
             const int bandRow = plan.interleaved ? 0 : ty * plan.tileHeight;

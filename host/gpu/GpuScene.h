@@ -38,8 +38,8 @@ static_assert(sizeof(SlotState) == 192 && offsetof(SlotState, lost) == 32 && off
               offsetof(SlotState, treeRays) == 128 && offsetof(SlotState, rays) == 136 &&
               offsetof(SlotState, frontierOld) == 152 && offsetof(SlotState, cutOff) == 160 &&
               offsetof(SlotState, settledWeight) == 176);
-static_assert(sizeof(OutputPixel) == 64 && offsetof(OutputPixel, truncation) == 16 &&
-              offsetof(OutputPixel, undecided) == 32 && offsetof(OutputPixel, shading) == 48);
+static_assert(sizeof(OutputPixel) == 32 && offsetof(OutputPixel, estimate) == 16 &&
+              offsetof(OutputPixel, report) == 20 && offsetof(OutputPixel, moved) == 28);
 static_assert(sizeof(PendingRay) == 64 && offsetof(PendingRay, depth) == 48 && offsetof(PendingRay, resumeShading) == 60);
 // An ellipsoid's index rides in a float (Sphere::anchorRadius.w), exact to the
 // documented sphere limit.

@@ -18,16 +18,19 @@ PixelTruncation truncationOf(const OutputPixel& out, int imageX, int imageY) {
     pixel.y = imageY;
     pixel.bound = std::abs(out.colour.a);  // negative where not finite
     pixel.unbounded = out.colour.a < 0.0f;
-    pixel.overBudget = out.truncation.y != 0.0f;
-    pixel.overTolerance = out.truncation.z != 0.0f;
-    pixel.estimated = out.truncation.x >= 0.0f;
-    if (pixel.estimated) pixel.estimatedError = out.truncation.x;  // the kernel reports no other estimate
-    pixel.droppedGrowing = out.truncation.z == 2.0f;
+    pixel.overBudget = (out.report & SNELL_PIXEL_OVER_BUDGET) != 0;
+    pixel.overTolerance = (out.report & (SNELL_PIXEL_OVER_TOLERANCE | SNELL_PIXEL_DROPPED_GROWING)) != 0;
+    pixel.estimated = out.estimate >= 0.0f;
+    if (pixel.estimated) pixel.estimatedError = out.estimate;  // the kernel reports no other estimate
+    pixel.droppedGrowing = (out.report & SNELL_PIXEL_DROPPED_GROWING) != 0;
     return pixel;
 }
 
 // Float's unit roundoff: the kernel's colours are float in either precision.
 constexpr double kFloatRoundoff = 0x1p-24;
+
+// The rays the pixel's trees traced (OutputPixel::report).
+std::uint32_t raysOf(const OutputPixel& out) { return out.report >> SNELL_PIXEL_RAYS_SHIFT; }
 
 // The relative rounding of the kernel's float colour arithmetic: a sum of n
 // terms >= 0 is within (n − 1)·u of its own value (Higham, "Accuracy and
@@ -35,7 +38,7 @@ constexpr double kFloatRoundoff = 0x1p-24;
 // (each with its lights), and each weight is a product of at most that many
 // factors.
 double sumRounding(const OutputPixel& out, std::size_t lights) {
-    return (double(out.truncation.w) + 4.0) * (double(lights) + 1.0) * kFloatRoundoff;
+    return (double(raysOf(out)) + 4.0) * (double(lights) + 1.0) * kFloatRoundoff;
 }
 // What it may have rounded away of the clamped colour and its bound.
 double colourRounding(const OutputPixel& out, const PixelTruncation& pixel, std::size_t lights) {
@@ -44,11 +47,11 @@ double colourRounding(const OutputPixel& out, const PixelTruncation& pixel, std:
 }
 
 // What the pixel's float sum may hold beyond the exact one's (whiteEitherWay):
-// light the exact tree may not hold (covered rays', undecided shadow rays'),
-// shading's rounding (`shading`, per sample) and the sum's own at its value.
-double excessOf(const OutputPixel& out, double shading, int samples, std::size_t lights) {
+// what the kernel reports (OutputPixel::excess) and the sum's own rounding at
+// its value.
+double excessOf(const OutputPixel& out, std::size_t lights) {
     const double colour = std::max({out.colour.r, out.colour.g, out.colour.b, 0.0f});
-    return double(out.shading.y) / samples + shading + sumRounding(out, lights) * colour;
+    return double(out.excess) + sumRounding(out, lights) * colour;
 }
 
 // Above this, what a pixel's float decisions and shading may have got wrong
@@ -59,43 +62,18 @@ double retraceAbove(const RenderRequest& request) {
     return request.trace.tolerance > 0.0 ? std::min(step, request.trace.tolerance) : step;
 }
 
-// What a pixel's undecided decisions (physics/margins.glsl) may change of its
-// colour, either way: its rays' weight times R, and its shadow rays' light.
-// Where R is infinite in a channel of that weight there is no bound, and
-// `guess` is the estimate, the weight times the most light one hit returns
-// (as for light not traced: render/Truncation.h, ErrorEstimate).
-struct Undecided {
-    double widening = 0.0;
-    double guess = 0.0;
-    bool bounded = true;
-};
-Undecided undecidedOf(const OutputPixel& out, const RadianceBound& radiance, int samples) {
-    Undecided u;
-    const float weight[3] = {out.undecided.r, out.undecided.g, out.undecided.b};
-    double widening = 0.0, guess = 0.0;
-    for (int c = 0; c < 3; ++c) {
-        if (!(weight[c] > 0.0f)) continue;
-        if (std::isfinite(radiance.radiance[c])) widening = std::max(widening, weight[c] * radiance.radiance[c]);
-        else u.bounded = false;
-        guess = std::max(guess, weight[c] * radiance.local[c]);
-    }
-    u.widening = (widening + out.undecided.a) / samples;
-    u.guess = (std::max(widening, guess) + out.undecided.a) / samples;
-    return u;
-}
-
-// The pixel's bound widened to cover both outcomes, where there is one. Else
-// a pixel that states an estimate keeps it, grown by the guess, while that is
-// within `small`; past it, the pixel has no bound but the clamp, and no
-// estimate (render/Truncation.h: TruncationReport::undecidedUnbounded).
-void widen(PixelTruncation& pixel, const OutputPixel& out, const Undecided& u, double small) {
+// The pixel marked undecided, and what its undecided decisions may have moved
+// (OutputPixel::moved) covered. Where the kernel found that movement bounded
+// (R finite in every channel its undecided rays weigh) the bound is widened;
+// else `moved` was a guess, and a pixel that states an estimate keeps it,
+// grown by the guess, while that is within `small`; past it, the pixel has no
+// bound but the clamp, and no estimate (render/Truncation.h:
+// TruncationReport::undecidedUnbounded). The caller adds `moved` to the bound.
+void widen(PixelTruncation& pixel, const OutputPixel& out, double small) {
     pixel.undecided = true;
-    if (u.bounded) {
-        pixel.bound = std::min(1.0, pixel.bound + u.widening);
-        return;
-    }
-    if (pixel.estimated && u.guess <= small) {
-        pixel.estimatedError += u.guess;
+    if ((out.report & SNELL_PIXEL_MOVED_UNBOUNDED) == 0) return;
+    if (pixel.estimated && out.moved <= small) {
+        pixel.estimatedError += out.moved;
         return;
     }
     pixel.bound = std::max(pixel.bound, clampOnlyBound(glm::dvec3(out.colour.r, out.colour.g, out.colour.b)));
@@ -108,7 +86,7 @@ void widen(PixelTruncation& pixel, const OutputPixel& out, const Undecided& u, d
 // reference, whose time a ray is several of the kernel's: their bound is
 // widened instead (docs/accuracy.md, "Decisions"). Nor are pixels that state
 // an estimate, not a bound: the reference would only estimate them again.
-constexpr float kRetraceRays = 1024.0f;
+constexpr std::uint32_t kRetraceRays = 1024;
 
 }  // namespace
 
@@ -118,7 +96,6 @@ void readBackTile(const OutputPixel* pixels, const RenderRequest& request, const
     const auto readStart = Clock::now();
     const PixelWindow& area = plan.area;
     TruncationReport& truncation = progress.truncation;
-    const int samples = request.samplesTraced();
     std::vector<RetracedPixel> retraced;
     for (std::uint32_t y = 0; y < tile.height; ++y) {
         const int imageY = imageRow(tile, y), windowRow = imageY - area.y0;
@@ -132,32 +109,28 @@ void readBackTile(const OutputPixel* pixels, const RenderRequest& request, const
             row[column * 3 + 2] = out.colour.b;
             PixelTruncation pixel = truncationOf(out, imageX, imageY);
             if (request.rayImage)
-                (*request.rayImage)[std::size_t(windowRow) * area.width() + column] = out.truncation.w;
+                (*request.rayImage)[std::size_t(windowRow) * area.width() + column] = float(raysOf(out));
             // What the float decisions and shading may have got wrong: past
             // what a bound should take, the pixel is traced again in double.
-            const Undecided undecided = undecidedOf(out, facts.radiance, samples);
-            const bool any = out.undecided.r > 0.0f || out.undecided.g > 0.0f || out.undecided.b > 0.0f ||
-                             out.undecided.a > 0.0f;
-            const double shading = out.shading.x / double(samples);
+            const bool undecided = (out.report & SNELL_PIXEL_UNDECIDED) != 0;
+            const double moved = out.moved;
             // A pixel white whichever way its decisions went needs neither.
-            if ((any || shading > 0.0) &&
-                whiteEitherWay(glm::dvec3(out.colour.r, out.colour.g, out.colour.b),
-                               excessOf(out, shading, samples, facts.lights))) {
+            if ((undecided || moved > 0.0) &&
+                whiteEitherWay(glm::dvec3(out.colour.r, out.colour.g, out.colour.b), excessOf(out, facts.lights))) {
                 truncation.add(pixel);
                 request.recordTruncation(std::size_t(windowRow) * area.width() + column, pixel);
                 continue;
             }
-            const double moved = (undecided.bounded ? undecided.widening : undecided.guess) + shading;
-            if ((any || shading > 0.0) && request.retrace && !(moved <= retraceAbove(request)) &&
-                !pixel.unbounded && out.truncation.w <= kRetraceRays) {
+            if ((undecided || moved > 0.0) && request.retrace && !(moved <= retraceAbove(request)) &&
+                !pixel.unbounded && raysOf(out) <= kRetraceRays) {
                 RetracedPixel again;
                 again.x = imageX;
                 again.y = imageY;
                 retraced.push_back(again);
                 continue;
             }
-            if (any) widen(pixel, out, undecided, retraceAbove(request));
-            pixel.bound = std::min(1.0, pixel.bound + shading + colourRounding(out, pixel, facts.lights));
+            if (undecided) widen(pixel, out, retraceAbove(request));
+            pixel.bound = std::min(1.0, pixel.bound + moved + colourRounding(out, pixel, facts.lights));
             truncation.add(pixel);
             request.recordTruncation(std::size_t(windowRow) * area.width() + column, pixel);
         }

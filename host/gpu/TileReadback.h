@@ -15,7 +15,6 @@ namespace snell::gpu {
 // bound should take, else its bound is widened.
 struct SceneFacts {
     std::size_t lights = 0;
-    RadianceBound radiance;  // render/Truncation.h
 };
 void readBackTile(const OutputPixel* pixels, const RenderRequest& request, const TilePlan& plan,
                   const TileParams& tile, const SceneFacts& facts, Image& rows, int firstRow, RenderProgress& progress,

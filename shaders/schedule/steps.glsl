@@ -98,6 +98,27 @@ void beginStep(inout SlotState state) {
     state.frontierOld = state.frontierCount;
 }
 
+// What a pixel's undecided decisions and shading's rounding may have done to
+// its colour, a sample's mean, for its host (host/gpu/TileReadback.cpp: a
+// re-trace, a wider bound, or neither where the pixel is white either way):
+// `moved`, how far either way (its undecided rays' weight times R, where R is
+// finite in every channel they weigh, else times the most light one hit
+// returns; its undecided shadow rays' light; shading's rounding), and
+// `excess`, the light its sum holds that the exact one may not. Returns its
+// flags. Rounded up by 2^-20 of themselves: a few float operations' rounding.
+uint undecidedReport(SlotState state, out float excess, out float moved) {
+    const float up = (1.0 + 1.0 / 1048576.0) / float(samples);
+    vec3 weight = state.undecided.rgb;
+    bvec3 weighs = greaterThan(weight, vec3(0.0));
+    bool unbounded = any(bvec3(uvec3(weighs) & uvec3(isinf(frame.radiance.rgb))));
+    float widening = maxChannel(mix(vec3(0.0), weight * frame.radiance.rgb, bvec3(uvec3(weighs) & uvec3(not(isinf(frame.radiance.rgb))))));
+    if (unbounded) widening = max(widening, maxChannel(weighted(weight, frame.localRadiance.rgb)));
+    moved = (widening + state.undecided.a + state.shading) * up;
+    excess = (state.unsureLight + state.shading) * up;
+    bool undecided = any(weighs) || state.undecided.a > 0.0;
+    return (undecided ? SNELL_PIXEL_UNDECIDED : 0u) | (undecided && unbounded ? SNELL_PIXEL_MOVED_UNBOUNDED : 0u);
+}
+
 // The finished pixel written out (render/Truncation.h: its colour, bound and
 // how it stopped), and the invocation moved on to its next pixel.
 void finishPixel(uint slot, inout SlotState state, StepOutcome o, uint shadowRays) {
@@ -105,11 +126,14 @@ void finishPixel(uint slot, inout SlotState state, StepOutcome o, uint shadowRay
     // neither a bound nor an estimate: it is over the tolerance, and says why.
     bool dropped = state.droppedGrowing != 0u && o.unbounded;
     bool overTolerance = tolerance > 0.0 && !o.certified && (!o.settled || dropped);
-    outputPixels[state.pixel] = OutputPixel(
-        vec4(state.lower.rgb, o.unbounded ? -o.bound : o.bound),
-        vec4(o.settled && !dropped ? o.estimate : -1.0, float(state.overBudget),
-             dropped ? 2.0 : overTolerance ? 1.0 : 0.0, float(state.treeRays)),
-        state.undecided, vec4(state.shading, state.unsureLight, 0.0, 0.0));
+    uint flags = (state.overBudget != 0u ? SNELL_PIXEL_OVER_BUDGET : 0u) |
+                 (overTolerance ? SNELL_PIXEL_OVER_TOLERANCE : 0u) | (dropped ? SNELL_PIXEL_DROPPED_GROWING : 0u);
+    float excess = 0.0, moved = 0.0;
+    if (DECISIONS) flags |= undecidedReport(state, excess, moved);
+    outputPixels[state.pixel] = OutputPixel(vec4(state.lower.rgb, o.unbounded ? -o.bound : o.bound),
+                                            o.settled && !dropped ? o.estimate : -1.0,
+                                            min(state.treeRays, SNELL_PIXEL_RAYS_LIMIT) << SNELL_PIXEL_RAYS_SHIFT | flags,
+                                            excess, moved);
     uint finished = state.finished + 1u;
     uint rays = state.rays;
     state = freshPixel(takePixel());
