@@ -101,7 +101,8 @@ using uint = std::uint32_t;
 #define SNELL_SPEC_LIGHTS_IN_FRAME 22  // the lights are read from FrameParams.lights
 #define SNELL_SPEC_STACKS_BY_ADDRESS 23  // the ray and media stacks through their addresses (FrameParams.rayStackAddress)
 #define SNELL_SPEC_DECISIONS 24  // decisions keep their rounding margins (physics/margins.glsl)
-#define SNELL_SPEC_COUNT 25
+#define SNELL_SPEC_BY_SAMPLE 25  // each sample's light kept apart, so that some may be re-traced alone (FlaggedSamples)
+#define SNELL_SPEC_COUNT 26
 // The deepest walk stack kept in registers (entries); a deeper one is an array
 // at a per-lane index.
 #define SNELL_REGISTER_STACK_LIMIT 32
@@ -259,6 +260,26 @@ struct SlotState {
     float shading;       // the light shading's rounding may have moved, largest channel, over its samples
     float unsureLight;   // the light its sum holds that the exact tree's may not (covered rays', ray.glsl;
                          // undecided shadow rays'), largest channel, over its samples
+    // Its samples, each kept apart until its first step's tree ends (SNELL_SPEC_BY_SAMPLE; steps.glsl,
+    // closeSample), so that the host may re-trace only those whose light hangs on an undecided decision:
+    vec4 sampleLight;    // rgb: the current sample's light so far; a: its shading's rounding
+    vec4 flagged;        // rgb: the light of its flagged samples; a: the shading's rounding of the others
+    uint flaggedLow;     // bit k: its sample k (frame.firstSample + k) flagged, k < 32;
+    uint flaggedHigh;    // bit k − 32: 32 <= k < 64
+    uint sampleFlagged;  // 1: the current sample met an undecided decision
+    uint pad0;
+};
+
+// Where a pixel traced one step with SNELL_SPEC_BY_SAMPLE on, its flagged
+// samples (SlotState::flagged), written beside its OutputPixel through
+// FrameParams.flaggedAddress: the host re-traces only those, where they hold
+// all its undecided light (host/gpu/TileReadback.cpp, samplesToRetrace).
+struct FlaggedSamples {
+    vec4 light;  // rgb: their light, summed; a: the others' shading's rounding, summed
+    uint low;    // SlotState::flaggedLow, flaggedHigh; both 0 where the pixel is re-traced whole, if at all
+    uint high;
+    uint pad0;
+    uint pad1;
 };
 
 // What the shader writes for each pixel of a tile: 32 bytes, what the host
@@ -336,8 +357,8 @@ struct FrameParams {
     uint mediaStackAddressLow;
     uint mediaStackAddressHigh;
     float sphereExtent; // no true sphere's point lies farther from the origin (rounded up; physics/hit.glsl, beginSearch)
-    uint pad1;
-    uint pad2;
+    uint flaggedAddressLow;   // where FlaggedSamples go (SNELL_SPEC_BY_SAMPLE), low and high 32 bits
+    uint flaggedAddressHigh;
     // A scene of at most SNELL_FRAME_LIGHTS lights has them here again
     // (SNELL_SPEC_LIGHTS_IN_FRAME): the lights' loop reads light j at one index
     // for the whole SIMD row, a scalar load, where a texel fetch is a call of

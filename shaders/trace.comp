@@ -131,7 +131,7 @@ void main() {
             // Where rounding may have chosen the hit, the ray's light may be
             // either answer's: at most its weight times R (margins.glsl).
             if (DECISIONS && h.undecided && !ray.covered && ray.resumeShading == 0u) {
-                state.undecided.rgb += weight;
+                addUndecided(state, vec4(weight, 0.0));
                 ray.covered = true;
             }
             if (!shading) addLight(state, ray, weighted(weight, frame.background.rgb), false);

@@ -89,6 +89,21 @@ for backend in "" --cpu; do
     bad "white either way (${backend:-gpu}): ${retraced:-?} re-traced, ${undecided:-?} widened: $(cat "$work/err")"
 done
 
+# A supersampled pixel re-traces only its samples whose light hangs on an
+# undecided decision (SlotState::flagged): decide-nearest at 4 × 4 samples,
+# where the disc's edge pixels hold samples on both sides of it. Fewer samples
+# than all of the re-traced pixels' are traced again, some are, and every
+# pixel lies within its stated bound.
+"$SNELL" render "$SCENES/hard/decide-nearest.scn" --spp 4 --size 32 -o "$work/spp.pfm" --stats -q \
+  >"$work/stats" 2>"$work/err"
+retraced=$(grep -o '"retraced_pixels": [0-9]*' "$work/stats" | grep -o '[0-9]*$')
+samples=$(grep -o '"retraced_samples": [0-9]*' "$work/stats" | grep -o '[0-9]*$')
+[ -n "$samples" ] && [ "$samples" -gt 0 ] && [ "$samples" -lt $((16 * ${retraced:-0})) ] && ok ||
+  bad "per-sample re-trace: ${samples:-?} samples of ${retraced:-?} pixels re-traced: $(cat "$work/err")"
+if "$PYTHON" "$(dirname "$0")/stated_bound.py" --snell "$SNELL" --size 32 --gpu-args "--spp 4" --cpu-args "--spp 4" \
+  "$SCENES/hard/decide-nearest.scn" >"$work/out" 2>&1; then ok
+else bad "per-sample re-trace: a pixel beyond the stated bounds: $(grep -v '^$' "$work/out" | head -3)"; fi
+
 # The CPU reference's bound covers its own rounding: basic.scn's trees end
 # (no light is left untraced), yet its pixels sum rounded terms, so none
 # states a bound of 0, nor more than rounding.

@@ -119,7 +119,11 @@ TEST(Layout, TileParams) {
 }
 
 TEST(Layout, SlotStateAndPendingRay) {
-    EXPECT_EQ(sizeof(gpu::SlotState), 192u);
+    EXPECT_EQ(sizeof(gpu::SlotState), 240u);
+    EXPECT_EQ(offsetof(gpu::SlotState, sampleLight), 192u);
+    EXPECT_EQ(offsetof(gpu::SlotState, flaggedHigh), 228u);
+    EXPECT_EQ(sizeof(gpu::FlaggedSamples), 32u);
+    EXPECT_EQ(offsetof(gpu::FlaggedSamples, low), 16u);
     EXPECT_EQ(offsetof(gpu::SlotState, deferred), 16u);
     EXPECT_EQ(offsetof(gpu::SlotState, lower), 48u);
     EXPECT_EQ(offsetof(gpu::SlotState, settled), 80u);

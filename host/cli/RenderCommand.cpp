@@ -63,7 +63,7 @@ std::string truncationJson(const TruncationReport& t) {
       << ", \"unbounded_pixels\": " << t.unbounded << ", \"over_budget_pixels\": " << t.overBudget
       << ", \"over_tolerance_pixels\": " << t.overTolerance << ", \"estimated_pixels\": " << t.estimated
       << ", \"dropped_growing_pixels\": " << t.droppedGrowing << ", \"undecided_pixels\": " << t.undecided
-      << ", \"retraced_pixels\": " << t.retraced
+      << ", \"retraced_pixels\": " << t.retraced << ", \"retraced_samples\": " << t.retracedSamples
       << ", \"max_estimated_error\": " << t.maxEstimate << ", \"deepest_ray\": " << t.deepest << "}";
     return j.str();
 }

@@ -107,6 +107,9 @@ GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool count
         const int bandRows = plan.bandRows();
         Image band = request.rowSink ? Image(area.width(), bandRows) : Image();
         const auto* pixels = static_cast<const gpu::OutputPixel*>(k.output.mapped);
+        const auto* flagged = k.values[SNELL_SPEC_BY_SAMPLE] != 0
+                                  ? static_cast<const gpu::FlaggedSamples*>(k.flagged.mapped)
+                                  : nullptr;
         const gpu::SceneFacts facts{scene_.lights.size()};
         gpu::RenderProgress progress;
         for (int ty = 0; ty < plan.tilesY; ++ty) {
@@ -115,8 +118,8 @@ GpuRenderResult ComputeRenderer::render(const RenderRequest& request, bool count
                 const gpu::TileParams tile = plan.tile(tx, ty);
                 gpu::dispatchTile(context_, k, request, plan, tile, countRays, policy_.countLanes, progress, result);
                 if (request.rowSink)
-                    gpu::readBackTile(pixels, request, plan, tile, facts, band, bandRow, progress, result);
-                else gpu::readBackTile(pixels, request, plan, tile, facts, result.image, 0, progress, result);
+                    gpu::readBackTile(pixels, flagged, request, plan, tile, facts, band, bandRow, progress, result);
+                else gpu::readBackTile(pixels, flagged, request, plan, tile, facts, result.image, 0, progress, result);
             }
             const bool bandDone = !plan.interleaved || ty + 1 == plan.tilesY;
             if (request.rowSink && bandDone) request.rowSink(band.rgb.data(), std::min(bandRows, area.height() - bandRow));

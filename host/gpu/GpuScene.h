@@ -33,11 +33,13 @@ static_assert(offsetof(FrameParams, cornerDir) == 16 &&
               sizeof(FrameParams) == 224 + 32 * SNELL_FRAME_LIGHTS);
 static_assert(sizeof(TileParams) == 32 && offsetof(TileParams, resume) == 16 &&
               offsetof(TileParams, workgroupStride) == 20 && offsetof(TileParams, strideY) == 28);
-static_assert(sizeof(SlotState) == 192 && offsetof(SlotState, lost) == 32 && offsetof(SlotState, undecided) == 96 &&
+static_assert(sizeof(SlotState) == 240 && offsetof(SlotState, sampleLight) == 192 &&
+              offsetof(SlotState, flaggedLow) == 224 && offsetof(SlotState, lost) == 32 && offsetof(SlotState, undecided) == 96 &&
               offsetof(SlotState, pixel) == 112 && offsetof(SlotState, finished) == 124 &&
               offsetof(SlotState, treeRays) == 128 && offsetof(SlotState, rays) == 136 &&
               offsetof(SlotState, frontierOld) == 152 && offsetof(SlotState, cutOff) == 160 &&
               offsetof(SlotState, settledWeight) == 176);
+static_assert(sizeof(FlaggedSamples) == 32 && offsetof(FlaggedSamples, high) == 20);
 static_assert(sizeof(OutputPixel) == 32 && offsetof(OutputPixel, estimate) == 16 &&
               offsetof(OutputPixel, report) == 20 && offsetof(OutputPixel, moved) == 28);
 static_assert(sizeof(PendingRay) == 64 && offsetof(PendingRay, depth) == 48 && offsetof(PendingRay, resumeShading) == 60);

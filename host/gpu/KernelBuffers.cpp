@@ -84,7 +84,14 @@ void prepareBuffers(vk::Context& context, Kernel& k, const SceneBuffers& scene, 
         // The tile's pixels, which the host reads where the shader wrote them
         // (on lavapipe, an imageStore in a loop costs 13x a buffer store).
         k.output = context.createBuffer(k.tilePixels * sizeof(OutputPixel), kStorage, vk::Context::Memory::HostCached);
+        context.destroy(k.flagged);
     }
+    // Each pixel's flagged samples, beside it, where the kernel keeps them
+    // (SNELL_SPEC_BY_SAMPLE): written through its address, so that the other
+    // kernels need no binding for it.
+    if (k.values[SNELL_SPEC_BY_SAMPLE] != 0 && !k.flagged.buffer)
+        k.flagged = context.createBuffer(k.tilePixels * sizeof(FlaggedSamples), kStack, vk::Context::Memory::HostCached);
+    if (k.flagged.buffer) splitAddress(context.deviceAddress(k.flagged), frame.flaggedAddressLow, frame.flaggedAddressHigh);
     // The frame's block after the stacks: it holds their addresses.
     context.destroy(k.frame);
     context.destroy(k.frameLow);

@@ -164,7 +164,7 @@ void destroyKernel(vk::Context& context, Kernel& k) {
     if (k.layout) vkDestroyPipelineLayout(device, k.layout, nullptr);
     if (k.setLayout) vkDestroyDescriptorSetLayout(device, k.setLayout, nullptr);
     for (vk::Buffer* b : {&k.frame, &k.counters, &k.output, &k.slotStates, &k.rayStack, &k.mediaStack, &k.frameLow,
-                          &k.rayStackLow})
+                          &k.rayStackLow, &k.flagged})
         context.destroy(*b);
 }
 

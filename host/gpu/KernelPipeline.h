@@ -27,6 +27,7 @@ struct Kernel {
     VkFence fence = VK_NULL_HANDLE;
     vk::Buffer frame, counters, output, slotStates, rayStack, mediaStack;
     vk::Buffer frameLow, rayStackLow;  // fp64 only
+    vk::Buffer flagged;                // each pixel's FlaggedSamples, where SNELL_SPEC_BY_SAMPLE
     std::uint32_t rayEntries = 1;     // the RAY_STACK and FRONTIER specialisations: an invocation's entries
     std::uint32_t maxMedia = 1;       // the MAX_MEDIA specialisation
     bool wide = false;                // fp64: the low parts' buffers too

@@ -162,6 +162,9 @@ Specialisation specialise(const Scene& scene, const GpuScene& layout, const Kern
             : 0u;
     values[SNELL_SPEC_LOOP_BUDGET] = policy.loopBudget;
     values[SNELL_SPEC_COUNT_LANES] = policy.countLanes;
+    // (Whether or not this request re-traces: its cost probe shares the pipeline.)
+    const int samples = request.samplesTraced();
+    values[SNELL_SPEC_BY_SAMPLE] = policy.decisions && !layout.amplifying && samples > 1 && samples <= 64;
     return values;
 }
 

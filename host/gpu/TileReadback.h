@@ -16,7 +16,9 @@ namespace snell::gpu {
 struct SceneFacts {
     std::size_t lights = 0;
 };
-void readBackTile(const OutputPixel* pixels, const RenderRequest& request, const TilePlan& plan,
+// `flagged`: each pixel's FlaggedSamples, where the kernel kept them (else
+// null): a supersampled pixel then re-traces only its flagged samples.
+void readBackTile(const OutputPixel* pixels, const FlaggedSamples* flagged, const RenderRequest& request, const TilePlan& plan,
                   const TileParams& tile, const SceneFacts& facts, Image& rows, int firstRow, RenderProgress& progress,
                   GpuRenderResult& result);
 

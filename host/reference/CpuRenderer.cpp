@@ -458,11 +458,15 @@ void CpuRenderer::traceTree(const PendingRay& root, dvec3& pixelSum, double satu
     }
 }
 
-CpuRenderer::Pixel CpuRenderer::renderPixel(const RenderRequest& request, int x, int y, RayCounts& counts) const {
+CpuRenderer::Pixel CpuRenderer::renderPixel(const RenderRequest& request, int x, int y, RayCounts& counts,
+                                            std::uint64_t sampleMask) const {
     const int s = std::max(1, request.supersample);
     const int first = std::clamp(request.firstSample, 0, s * s - 1);
-    const int count = request.sampleCount > 0 ? std::min(request.sampleCount, s * s - first) : s * s - first;
-    const double samples = count;
+    const int all = request.sampleCount > 0 ? std::min(request.sampleCount, s * s - first) : s * s - first;
+    auto traced = [&](int k) { return sampleMask == 0 || (k - first < 64 && ((sampleMask >> (k - first)) & 1u) != 0); };
+    int count = 0;
+    for (int k = first; k < first + all; ++k) count += traced(k) ? 1 : 0;
+    const double samples = std::max(count, 1);
     // Only amplifying scenes stop saturated channels: elsewhere the float
     // output keeps the whole unclamped sum (SPEC §6).
     const double saturation = amplifying_ ? samples : kNoHit;
@@ -482,7 +486,8 @@ CpuRenderer::Pixel CpuRenderer::renderPixel(const RenderRequest& request, int x,
     tree.traps = traps.get();
     tree.anyTrap = std::find(traps->begin(), traps->end(), true) != traps->end();
     const bool continues = settings.tolerance > 0.0;
-    for (int k = first; k < first + count; ++k) {
+    for (int k = first; k < first + all; ++k) {
+        if (!traced(k)) continue;
         ++counts.primary;
         traceTree(cameraRay(request.camera, s, x, y, k), sum, saturation,
                   continues ? std::max(settings.minWeight, kFirstRung) : settings.minWeight, settings, counts, tree);
@@ -537,12 +542,14 @@ CpuRenderer::Pixel CpuRenderer::renderPixel(const RenderRequest& request, int x,
         margins::kChain * kUnitRoundoff * terms * (maxComponent(glm::abs(pixel.colour)) + pixel.bound);
     const dvec3 spread = weighted(tree.undecidedWeight, radiance_.radiance) + tree.undecidedLight;
     pixel.widening = maxComponent(spread) / samples + rounding;
-    // White whichever way its decisions went: the exact pixel is white too.
+    pixel.gap = maxComponent(estimate.upper - estimate.lower);
+    // White whichever way its decisions went: the exact pixel is white too,
+    // and its bound stays (its widening is kept for a pixel some of whose
+    // samples these are: TileReadback.cpp, combineSamples).
     const bool white = whiteEitherWay(pixel.colour, tree.excess / samples + rounding);
     pixel.undecided = tree.undecided && !white;
-    if (white) {
-        pixel.widening = 0.0;
-    } else if (std::isfinite(pixel.widening)) {
+    if (white) return pixel;
+    if (std::isfinite(pixel.widening)) {
         pixel.bound = std::min(1.0, pixel.bound + pixel.widening);
     } else {
         pixel.bound = std::max(pixel.bound, clampOnlyBound(pixel.colour));

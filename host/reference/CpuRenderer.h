@@ -38,10 +38,14 @@ public:
         // colour, and `widening` of it is that.
         bool undecided = false;
         double widening = 0.0;
+        double gap = 0.0;  // its truncation bound before the clamp, largest channel (+inf: none)
         // As a renderer reports it, for pixel (x, y).
         PixelTruncation truncation(int x, int y) const;
     };
-    Pixel renderPixel(const RenderRequest& request, int x, int y, RayCounts& counts) const;
+    // sampleMask: only the samples whose bit is set (bit k: the request's
+    // sample firstSample + k), their mean; 0: all of them.
+    Pixel renderPixel(const RenderRequest& request, int x, int y, RayCounts& counts,
+                      std::uint64_t sampleMask = 0) const;
     const RadianceBound& radiance() const { return radiance_; }
 
     // The closest hit of a ray (SPEC §4.1) and how sure it is (Margins.h).

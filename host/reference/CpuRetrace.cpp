@@ -26,9 +26,11 @@ struct Retrace {
             RayCounts counts;
             for (std::size_t i; (i = next.fetch_add(1)) < pixels.size();) {
                 RetracedPixel& p = pixels[i];
-                const CpuRenderer::Pixel traced = reference->renderPixel(request, p.x, p.y, counts);
+                const CpuRenderer::Pixel traced = reference->renderPixel(request, p.x, p.y, counts, p.samples);
                 p.colour = traced.colour;
                 p.truncation = traced.truncation(p.x, p.y);
+                p.widening = traced.widening;
+                p.gap = traced.gap;
             }
         };
         const std::size_t threads =

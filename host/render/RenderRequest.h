@@ -125,8 +125,11 @@ struct CostMap {
 // to the CPU reference: where it is, and what the reference makes of it.
 struct RetracedPixel {
     int x = 0, y = 0;
-    glm::dvec3 colour{0.0};
+    std::uint64_t samples = 0;  // only these (bit k: sample firstSample + k); 0: all
+    glm::dvec3 colour{0.0};     // their mean
     PixelTruncation truncation;
+    double widening = 0.0;  // of the bound, on either side of the colour (CpuRenderer::Pixel)
+    double gap = 0.0;       // the truncation bound before the clamp, largest channel
 };
 
 struct RenderRequest {

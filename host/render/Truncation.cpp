@@ -203,6 +203,7 @@ void TruncationReport::add(const PixelTruncation& p) {
     if (p.unbounded) ++unbounded;
     undecided += p.undecided;
     retraced += p.retraced;
+    retracedSamples += std::uint64_t(p.retracedSamples);
     if (p.estimated) {
         ++estimated;
         maxEstimate = std::max(maxEstimate, p.estimatedError);
@@ -226,6 +227,7 @@ void TruncationReport::merge(const TruncationReport& o) {
     undecided += o.undecided;
     undecidedUnbounded += o.undecidedUnbounded;
     retraced += o.retraced;
+    retracedSamples += o.retracedSamples;
     droppedGrowing += o.droppedGrowing;
     maxEstimate = std::max(maxEstimate, o.maxEstimate);
     maxBound = std::max(maxBound, o.maxBound);

@@ -162,6 +162,7 @@ struct PixelTruncation {
     // its bound is widened to cover both outcomes, on both sides of the colour.
     bool undecided = false;
     bool retraced = false;        // the GPU's float decisions were undecided: re-traced by the CPU reference
+    int retracedSamples = 0;      // of its samples, those re-traced (all, or those whose light hung on them)
 };
 
 // A render's truncation, summed over its pixels.
@@ -178,6 +179,7 @@ struct TruncationReport {
     std::uint64_t undecided = 0;     // pixels whose bound covers an undecided decision (widened)
     std::uint64_t undecidedUnbounded = 0;  // of those, pixels left with no finite bound by that alone
     std::uint64_t retraced = 0;      // pixels the GPU left undecided, re-traced by the CPU reference
+    std::uint64_t retracedSamples = 0;  // and their samples re-traced
     double maxEstimate = 0.0;        // the largest estimated error of the estimated pixels
     int deepest = 0;                 // the deepest ray traced (generations below the primary ray)
     static constexpr std::size_t kExamples = 8;

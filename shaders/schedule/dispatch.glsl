@@ -7,6 +7,11 @@
 #define SNELL_SCHEDULE_DISPATCH_GLSL
 
 layout(constant_id = SNELL_SPEC_AMPLIFYING) const bool AMPLIFYING = false;
+// Each sample's light kept apart until its first step ends, so that the host
+// may re-trace only the samples whose light hangs on an undecided decision
+// (steps.glsl, closeSample): with margins, 2 to 64 samples, and light that
+// cannot grow (saturation would tie a pixel's samples together).
+layout(constant_id = SNELL_SPEC_BY_SAMPLE) const bool BY_SAMPLE = false;
 // Some material traps light, where it grows without end (ks.w of a material;
 // render/Truncation.h, growthTraps): a pixel whose trees meet one may go on
 // below the floor, so rays under the floor wait rather than being lost.

@@ -138,8 +138,8 @@ void shadeLightsShared(inout SlotState state, Ray r, vec3 weight, Hit h, bool sh
             vec3 term = lightTerm(firstLight + b, h, toLight, nl, v, DECISIONS ? cosineOffset(h, lightDistance) : 0.0,
                                   error);
             if ((blocked & mine) == 0u) addLight(state, r, weighted(weight, term), (undecided & mine) != 0u);
-            if (DECISIONS && (blocked & mine) == 0u && !r.covered) state.shading += maxChannel(weighted(weight, error));
-            if ((undecided & mine) != 0u && !r.covered) state.undecided.a += maxChannel(weighted(weight, term));
+            if (DECISIONS && (blocked & mine) == 0u && !r.covered) addShadingError(state, maxChannel(weighted(weight, error)));
+            if ((undecided & mine) != 0u && !r.covered) addUndecided(state, vec4(vec3(0.0), maxChannel(weighted(weight, term))));
         }
     }
 }
@@ -181,8 +181,8 @@ bool shadeLights(inout SlotState state, inout Ray r, vec3 weight, Hit h, bool sh
             if (COUNT_RAYS && castShadowRay) countedRays[SNELL_COUNTER_SHADOW]++;
             if (castShadowRay) shadowRays++;
             addLight(state, r, weighted(weight, term), maxChannel(undecided) > 0.0);
-            if (DECISIONS && !r.covered) state.undecided.a += maxChannel(weighted(weight, undecided));
-            if (DECISIONS && !r.covered) state.shading += maxChannel(weighted(weight, error));
+            if (DECISIONS && !r.covered) addUndecided(state, vec4(vec3(0.0), maxChannel(weighted(weight, undecided))));
+            if (DECISIONS && !r.covered) addShadingError(state, maxChannel(weighted(weight, error)));
         }
     }
     return false;

@@ -11,7 +11,33 @@ layout(set = 0, binding = SNELL_BINDING_OUTPUT, std430) writeonly buffer OutputB
 
 SlotState freshPixel(uint pixelIndex) {
     return SlotState(vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0), vec4(INFINITY), vec4(0.0), vec4(0.0), pixelIndex, 0u, 0u, 0u,
-                     0u, 0u, 0u, 0u, 0u, 0u, 0u, 0u, firstCutOff, 0.0, INFINITY, INFINITY, 0.0, 0u, 0.0, 0.0);
+                     0u, 0u, 0u, 0u, 0u, 0u, 0u, 0u, firstCutOff, 0.0, INFINITY, INFINITY, 0.0, 0u, 0.0, 0.0,
+                     vec4(0.0), vec4(0.0), 0u, 0u, 0u, 0u);
+}
+
+// Where a pixel's flagged samples go (BY_SAMPLE): beside its OutputPixel, at
+// the tile's pixel index. (A macro: SPIRV-Tools' dead-code pass of Debian 12
+// fails on a call that returns a buffer reference.)
+layout(buffer_reference, std430, buffer_reference_align = 16) writeonly buffer FlaggedSampleBlock { FlaggedSamples pixels[]; };
+#define flaggedSamples() FlaggedSampleBlock(uvec2(frame.flaggedAddressLow, frame.flaggedAddressHigh))
+
+// The first step's tree of the pixel's latest sample is finished (BY_SAMPLE):
+// where its light hangs on an undecided decision, or its shading's rounding
+// is more than the host lets a pixel keep without a re-trace (TileReadback.cpp,
+// retraceAbove), the sample is flagged and its light kept apart; else its
+// shading's rounding joins the others'.
+void closeSample(inout SlotState state) {
+    uint k = state.started - 1u;
+    float limit = tolerance > 0.0 ? min(0.5 / 255.0, tolerance) : 0.5 / 255.0;
+    if (state.sampleFlagged != 0u || state.sampleLight.a > limit) {
+        state.flagged.rgb += state.sampleLight.rgb;
+        if (k < 32u) state.flaggedLow |= 1u << k;
+        else state.flaggedHigh |= 1u << (k - 32u);
+    } else {
+        state.flagged.a += state.sampleLight.a;
+    }
+    state.sampleLight = vec4(0.0);
+    state.sampleFlagged = 0u;
 }
 
 // What a step of a pixel proves of its exact colour: its colour is a lower
@@ -134,6 +160,13 @@ void finishPixel(uint slot, inout SlotState state, StepOutcome o, uint shadowRay
                                             o.settled && !dropped ? o.estimate : -1.0,
                                             min(state.treeRays, SNELL_PIXEL_RAYS_LIMIT) << SNELL_PIXEL_RAYS_SHIFT | flags,
                                             excess, moved);
+    // Its flagged samples hold all its undecided light where each sample's
+    // light was kept apart to the end: where it ended after one step.
+    if (BY_SAMPLE) {
+        bool bySample = state.steps == 1u;
+        flaggedSamples().pixels[state.pixel] = FlaggedSamples(state.flagged, bySample ? state.flaggedLow : 0u,
+                                                              bySample ? state.flaggedHigh : 0u, 0u, 0u);
+    }
     uint finished = state.finished + 1u;
     uint rays = state.rays;
     state = freshPixel(takePixel());
@@ -147,6 +180,7 @@ void finishPixel(uint slot, inout SlotState state, StepOutcome o, uint shadowRay
 // pixel is finished and the invocation moves to its next one (pixel, within
 // the tile). Returns whether the invocation is done with the tile.
 bool endStep(uint slot, inout SlotState state, inout uvec2 pixel, inout float cutOff, uint shadowRays) {
+    if (BY_SAMPLE && state.steps == 0u) closeSample(state);  // its last sample's first step
     StepOutcome outcome = assessStep(state);
     float next = nextCutOff(state, outcome);
     if (next > 0.0) {

@@ -5,6 +5,19 @@
 #ifndef SNELL_SCHEDULE_TREE_GLSL
 #define SNELL_SCHEDULE_TREE_GLSL
 
+// Light that undecided decisions may change (margins.glsl): `amount` is the
+// weight of the rays whose light either outcome may change (rgb), or the
+// light of undecided shadow rays (a). It flags the sample (BY_SAMPLE).
+void addUndecided(inout SlotState state, vec4 amount) {
+    state.undecided += amount;
+    if (BY_SAMPLE && (maxChannel(amount.rgb) > 0.0 || amount.a > 0.0)) state.sampleFlagged = 1u;
+}
+// What shading's rounding may have moved of the light added.
+void addShadingError(inout SlotState state, float error) {
+    state.shading += error;
+    if (BY_SAMPLE) state.sampleLight.a += error;
+}
+
 // The next ray of the pixel's current step: a child waiting on the stack,
 // else a ray the last step left in the frontier, else a camera ray for its
 // next sample. False where the step has none left.
@@ -21,6 +34,7 @@ bool nextRay(uint slot, inout SlotState state, uvec2 pixel, out Ray ray) {
         return true;
     }
     if (state.started < samples) {
+        if (BY_SAMPLE && state.started > 0u) closeSample(state);
         ray = cameraRay(imagePixel(pixel), frame.firstSample + state.started);
         state.started++;
         if (COUNT_RAYS) countedRays[SNELL_COUNTER_PRIMARY]++;
@@ -34,6 +48,7 @@ bool nextRay(uint slot, inout SlotState state, uvec2 pixel, out Ray ray) {
 // kept apart, its largest channel (host/gpu/TileReadback.cpp, whiteEitherWay).
 void addLight(inout SlotState state, Ray r, vec3 light, bool unsure) {
     state.sum.rgb += light;
+    if (BY_SAMPLE) state.sampleLight.rgb += light;
     if (DECISIONS && (r.covered || unsure)) state.unsureLight += maxChannel(light);
 }
 
@@ -95,7 +110,7 @@ bool followChildren(uint slot, inout SlotState state, inout Ray r, vec3 weight, 
     // Reflected or refracted within the margin: either answer's children
     // carry light within their weights times R (margins.glsl).
     if (DECISIONS && c.undecided && !r.covered) {
-        state.undecided.rgb += weighted(weight, gain);
+        addUndecided(state, vec4(weighted(weight, gain), 0.0));
         c.reflected.covered = true;
         c.refracted.covered = true;
     }
