@@ -102,6 +102,7 @@ struct CpuRenderer::Hit {
     double normalOff = 0.0;    // exact ray's (Margins.h)
     double rounding = 0.0;     // of the point itself, and how fast the normal turns
     double turning = 0.0;      // with it (outwardNormal)
+    double viewTilt = 0.0;     // how far the ray's direction, V of shading, may be turned from the exact one's
     bool undecided = false;    // the exact ray may meet another surface, none, or this one from its other side
 };
 
@@ -259,6 +260,7 @@ bool CpuRenderer::findHit(const PendingRay& r, Hit& hit) const {
     hit.turning = turning;
     hit.pointOff = closest.margin + hit.rounding;
     hit.normalOff = margins::normalOff(hit.pointOff, turning, kUnitRoundoff);
+    hit.viewTilt = off.tilt;
     if (std::abs(facing) <= margins::facingMargin(off.tilt, hit.normalOff, kUnitRoundoff)) hit.undecided = true;
     return true;
 }
@@ -294,7 +296,7 @@ dvec3 CpuRenderer::shadeLight(const Light& light, const Hit& hit, const dvec3& v
         uncertain.undecided = true;
         if (!blocked) uncertain.excess += term;
     }
-    const double cosineOff = 2.0 * (hit.normalOff + toLight.tilt) + margins::kChain * kUnitRoundoff;
+    const double cosineOff = 2.0 * (hit.normalOff + toLight.tilt) + hit.viewTilt + margins::kChain * kUnitRoundoff;
     const double specularOff = rv > 0.0 ? specular * m.phong * cosineOff / rv : 0.0;
     if (!blocked) {
         const dvec3 error = light.colour * (m.kd * cosineOff + m.ks * specularOff);

@@ -234,6 +234,7 @@ bool findHit(Ray r, out Hit h) {
     h.rounding = CHAIN * UNIT_ROUNDOFF * (length(o) + t);
     h.pointOff = bestMargin + h.rounding;
     h.normalOff = normalOffset(h.pointOff, h.turning);
+    h.viewTilt = off.y;
     if (DECISIONS && abs(facing) <= facingMargin(off.y, h.normalOff)) h.undecided = true;
     return true;
 }

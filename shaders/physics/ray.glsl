@@ -61,6 +61,7 @@ struct Hit {
     real normalOff;   // (margins.glsl)
     real rounding;    // the point's own rounding, and how fast the normal turns with it
     real turning;
+    real viewTilt;    // how far the ray's direction, V of shading, may be turned from the exact one's
     bool undecided;   // the exact ray may meet another surface, none, or this one from its other side
 };
 

@@ -55,9 +55,9 @@ rvec2 shadowOff(Hit h, real distance) { return rvec2(h.pointOff, h.pointOff / di
 
 // How far N·L and R·V may be from the exact ones' at hit h, towards a light
 // at `distance`: the normal's and the light direction's uncertainty
-// (margins.glsl), and float rounding.
+// (margins.glsl), V's (the ray's direction's), and float rounding.
 float cosineOffset(Hit h, real distance) {
-    return float(2.0 * (h.normalOff + h.pointOff / distance)) + float(CHAIN) * 5.96e-8;
+    return float(2.0 * (h.normalOff + h.pointOff / distance) + h.viewTilt) + float(CHAIN) * 5.96e-8;
 }
 
 // Light j's part of the local term with binary shadows (SPEC §4.3), seen
