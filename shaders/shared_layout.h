@@ -58,22 +58,24 @@ using uint = std::uint32_t;
 // (SphereBlock; for fp64 followed by their low parts), which the shader's
 // loops read at one index for the whole SIMD row (a scalar load).
 #define SNELL_BINDING_SPHERE_BLOCK 12
-#define SNELL_BINDING_COUNT_FP32 13
+// Uniform texel buffer: each sphere's SphereReach (where SNELL_SPEC_REACH).
+#define SNELL_BINDING_REACH 13
+#define SNELL_BINDING_COUNT_FP32 14
 // The fp64 shader (--precision fp64) reads scene values as float pairs hi + lo
 // (hi = float(v), lo = float(v - hi): 48 bits of the host's double): the hi
 // parts are the buffers above, the lo parts twin buffers of the same layout.
-#define SNELL_BINDING_FRAME_LOW 13
-#define SNELL_BINDING_SPHERES_LOW 14
-#define SNELL_BINDING_ELLIPSOIDS_LOW 15
-#define SNELL_BINDING_LIGHTS_LOW 16
-#define SNELL_BINDING_RAY_STACK_LOW 17
-#define SNELL_BINDING_COUNT 18
+#define SNELL_BINDING_FRAME_LOW 14
+#define SNELL_BINDING_SPHERES_LOW 15
+#define SNELL_BINDING_ELLIPSOIDS_LOW 16
+#define SNELL_BINDING_LIGHTS_LOW 17
+#define SNELL_BINDING_RAY_STACK_LOW 18
+#define SNELL_BINDING_COUNT 19
 // The ray-query shader (fp32 only; --traversal ray-query) reads the spheres'
 // boxes as an acceleration structure (VK_KHR_acceleration_structure), the
 // driver's own traversal in place of the BVH walk: one geometry of AABBs,
 // primitive i the box of sphere i, in one instance.
-#define SNELL_BINDING_ACCELERATION 18
-#define SNELL_BINDING_LIMIT 19  // one past the largest binding
+#define SNELL_BINDING_ACCELERATION 19
+#define SNELL_BINDING_LIMIT 20  // one past the largest binding
 
 // Specialization constants: compile only what a scene uses.
 #define SNELL_SPEC_USE_BVH 0
@@ -102,7 +104,8 @@ using uint = std::uint32_t;
 #define SNELL_SPEC_STACKS_BY_ADDRESS 23  // the ray and media stacks through their addresses (FrameParams.rayStackAddress)
 #define SNELL_SPEC_DECISIONS 24  // decisions keep their rounding margins (physics/margins.glsl)
 #define SNELL_SPEC_BY_SAMPLE 25  // each sample's light kept apart, so that some may be re-traced alone (FlaggedSamples)
-#define SNELL_SPEC_COUNT 26
+#define SNELL_SPEC_REACH 26      // each ray's light bounded by where it starts (SphereReach)
+#define SNELL_SPEC_COUNT 27
 // The deepest walk stack kept in registers (entries); a deeper one is an array
 // at a per-lane index.
 #define SNELL_REGISTER_STACK_LIMIT 32
@@ -233,11 +236,11 @@ struct BvhNode {
 struct SlotState {
     vec4 sum;        // rgb: the pixel's sum over its samples so far
     vec4 deferred;   // rgb: the weight of the rays waiting in the frontier
-    vec4 lost;       // rgb: the weight of rays lost for good (depth limit, floor, tree budget, full stack)
+    vec4 lost;       // rgb: the most light of rays lost for good (depth limit, floor, tree budget, full stack)
     vec4 lower;      // rgb: the pixel's best lower and upper bounds over its steps so far
     vec4 upper;      //      (render/Truncation.h, PixelEstimate)
     vec4 settled;    // rgb: its colour after the last step, clamped (render/Truncation.h, ErrorEstimate)
-    vec4 undecided;  // rgb: the weight of its rays whose light undecided decisions may change; a: the light of
+    vec4 undecided;  // rgb: the most light of its rays whose light undecided decisions may change; a: the light of
                      // its undecided shadow rays, largest channel (physics/margins.glsl); over its samples
     uint pixel;      // the pixel of the tile in progress (row-major); ≥ tile size: done
     uint started;    // samples of it started
@@ -267,7 +270,8 @@ struct SlotState {
     uint flaggedLow;     // bit k: its sample k (frame.firstSample + k) flagged, k < 32;
     uint flaggedHigh;    // bit k − 32: 32 <= k < 64
     uint sampleFlagged;  // 1: the current sample met an undecided decision
-    uint pad0;
+    float undecidedLocal;  // the most light one hit of its undecided rays returns (RadianceBound::local), largest channel
+    vec4 deferredLight;  // rgb: the most light the rays waiting in the frontier can bring (render/Reach.h)
 };
 
 // Where a pixel traced one step with SNELL_SPEC_BY_SAMPLE on, its flagged
@@ -320,6 +324,14 @@ struct PendingRay {
     uint resumeShading;  // 0: not shaded yet; k > 0: suspended while shading, resumes at light k − 1
 };
 
+// The most light a ray can bring per unit weight, by where it starts
+// (render/Reach.h): leaving a sphere's surface outwards, or into it; one
+// per sphere, in the order of the spheres (SNELL_BINDING_REACH).
+struct SphereReach {
+    vec4 outward;  // rgb
+    vec4 inward;   // rgb
+};
+
 // Per-render parameters (uniform buffer). The primary ray through the image
 // point with pixel coordinates (x, y) has direction
 //   normalize(cornerDir + x * pixelRight + y * pixelDown)       (SPEC §3)
@@ -359,6 +371,10 @@ struct FrameParams {
     float sphereExtent; // no true sphere's point lies farther from the origin (rounded up; physics/hit.glsl, beginSearch)
     uint flaggedAddressLow;   // where FlaggedSamples go (SNELL_SPEC_BY_SAMPLE), low and high 32 bits
     uint flaggedAddressHigh;
+    uint reachInward;   // 1: SphereReach.inward holds for this eye (render/Reach.h, inwardHolds)
+    uint pad0;
+    uint pad1;
+    uint pad2;
     // A scene of at most SNELL_FRAME_LIGHTS lights has them here again
     // (SNELL_SPEC_LIGHTS_IN_FRAME): the lights' loop reads light j at one index
     // for the whole SIMD row, a scalar load, where a texel fetch is a call of

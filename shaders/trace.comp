@@ -129,9 +129,9 @@ void main() {
         if (hasRay && admitRay(slot, state, ray, cutOff, weight)) {
             shading = findHit(ray, h);
             // Where rounding may have chosen the hit, the ray's light may be
-            // either answer's: at most its weight times R (margins.glsl).
+            // either answer's: at most its weight times its reach (margins.glsl).
             if (DECISIONS && h.undecided && !ray.covered && ray.resumeShading == 0u) {
-                addUndecided(state, vec4(weight, 0.0));
+                addUndecided(state, vec4(weighted(weight, rayReach(ray)), 0.0), weight);
                 ray.covered = true;
             }
             if (!shading) addLight(state, ray, weighted(weight, frame.background.rgb), false);

@@ -73,8 +73,8 @@ glm::vec3 lowerOf(const gpu::BvhNode& n, int k) { return {n.lowerX[k], n.lowerY[
 glm::vec3 upperOf(const gpu::BvhNode& n, int k) { return {n.upperX[k], n.upperY[k], n.upperZ[k]}; }
 
 TEST(Layout, FrameParams) {
-    EXPECT_EQ(sizeof(gpu::FrameParams), 224u + 32u * SNELL_FRAME_LIGHTS);
-    EXPECT_EQ(offsetof(gpu::FrameParams, lights), 224u);
+    EXPECT_EQ(sizeof(gpu::FrameParams), 240u + 32u * SNELL_FRAME_LIGHTS);
+    EXPECT_EQ(offsetof(gpu::FrameParams, lights), 240u);
     EXPECT_EQ(offsetof(gpu::FrameParams, primaryStart), 0u);
     EXPECT_EQ(offsetof(gpu::FrameParams, cornerDir), 16u);
     EXPECT_EQ(offsetof(gpu::FrameParams, pixelRight), 32u);
@@ -105,6 +105,8 @@ TEST(Layout, FrameParams) {
     EXPECT_EQ(offsetof(gpu::FrameParams, mediaStackAddressLow), 204u);
     EXPECT_EQ(offsetof(gpu::FrameParams, mediaStackAddressHigh), 208u);
     EXPECT_EQ(offsetof(gpu::FrameParams, sphereExtent), 212u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, flaggedAddressLow), 216u);
+    EXPECT_EQ(offsetof(gpu::FrameParams, reachInward), 224u);
 }
 
 TEST(Layout, TileParams) {
@@ -119,9 +121,12 @@ TEST(Layout, TileParams) {
 }
 
 TEST(Layout, SlotStateAndPendingRay) {
-    EXPECT_EQ(sizeof(gpu::SlotState), 240u);
+    EXPECT_EQ(sizeof(gpu::SlotState), 256u);
     EXPECT_EQ(offsetof(gpu::SlotState, sampleLight), 192u);
     EXPECT_EQ(offsetof(gpu::SlotState, flaggedHigh), 228u);
+    EXPECT_EQ(offsetof(gpu::SlotState, undecidedLocal), 236u);
+    EXPECT_EQ(offsetof(gpu::SlotState, deferredLight), 240u);
+    EXPECT_EQ(sizeof(gpu::SphereReach), 32u);
     EXPECT_EQ(sizeof(gpu::FlaggedSamples), 32u);
     EXPECT_EQ(offsetof(gpu::FlaggedSamples, low), 16u);
     EXPECT_EQ(offsetof(gpu::SlotState, deferred), 16u);

@@ -158,20 +158,19 @@ TEST(TruncationReport, ExamplesOfEachKindOfPixel) {
 }
 
 TEST(PixelEstimate, ClampedToTheHeadroomAndZeroWhenSaturated) {
-    snell::RadianceBound b;
-    b.radiance = glm::dvec3(2.0, std::numeric_limits<double>::infinity(), 1.0);
-    // Red: 0.01 dropped * 2 = 0.02; green: unbounded, 1 - 0.7 = 0.3 of headroom.
+    const double inf = std::numeric_limits<double>::infinity();
+    // Red: 0.02 of light dropped; green: unbounded, 1 - 0.7 = 0.3 of headroom.
     snell::PixelEstimate e;
-    e.add(b, {0.5, 0.7, 0.2}, {0.01, 0.0, 0.0}, 1.0);
+    e.add({0.5, 0.7, 0.2}, {0.02, 0.0, 0.0}, 1.0);
     EXPECT_NEAR(e.bound(), 0.02, 1e-15);
     EXPECT_FALSE(e.unbounded());
     snell::PixelEstimate f;
-    f.add(b, {0.5, 0.7, 0.2}, {0.01, 0.5, 0.0}, 1.0);
+    f.add({0.5, 0.7, 0.2}, {0.02, inf, 0.0}, 1.0);
     EXPECT_NEAR(f.bound(), 0.3, 1e-12);
     EXPECT_TRUE(f.unbounded());
     // A channel already at 1 is final (SPEC §4, §6).
     snell::PixelEstimate g;
-    g.add(b, {0.5, 1.0, 0.2}, {0.0, 0.5, 0.0}, 1.0);
+    g.add({0.5, 1.0, 0.2}, {0.0, inf, 0.0}, 1.0);
     EXPECT_EQ(g.bound(), 0.0);
     EXPECT_FALSE(g.unbounded());
 }
@@ -195,12 +194,11 @@ TEST(WhiteEitherWay, EveryChannelStillAtLeastOne) {
 }
 
 TEST(PixelEstimate, KeepsTheBestOfEachAttempt) {
-    snell::RadianceBound b;
-    b.radiance = glm::dvec3(1.0, std::numeric_limits<double>::infinity(), 1.0);
+    const double inf = std::numeric_limits<double>::infinity();
     snell::PixelEstimate e;
     // Samples: 2, so the colours are half the sums.
-    e.add(b, {0.4, 1.0, 0.2}, {0.2, 0.2, 0.0}, 2.0);  // red in [0.2, 0.3]; green >= 0.5
-    e.add(b, {0.5, 3.0, 0.2}, {0.1, 0.0, 0.0}, 2.0);  // red in [0.25, 0.3]; green >= 1.5: final
+    e.add({0.4, 1.0, 0.2}, {0.2, inf, 0.0}, 2.0);  // red in [0.2, 0.3]; green >= 0.5
+    e.add({0.5, 3.0, 0.2}, {0.1, 0.0, 0.0}, 2.0);  // red in [0.25, 0.3]; green >= 1.5: final
     EXPECT_NEAR(e.lower.x, 0.25, 1e-15);
     EXPECT_NEAR(e.upper.x, 0.3, 1e-15);
     EXPECT_NEAR(e.lower.y, 1.5, 1e-15);

@@ -7,7 +7,9 @@
 #   many cut-off steps a pixel takes;
 # * a looser tolerance never traces more rays;
 # * a diverging pixel (light trapped in an amplifying material) comes out
-#   saturated, as the limit reference has it.
+#   saturated, as the limit reference has it;
+# * where R is infinite but each ray's reach is not (render/Reach.h: glass of
+#   ks + kt = 1 beside a mirror), every pixel states a finite bound.
 # TREE_PART=K/N runs the K-th of N parts (scenes dealt round; the diverging
 # scene in the first), so the parts run side by side; by default all of it.
 set -u
@@ -80,6 +82,19 @@ import json, sys
 m = json.load(open(sys.argv[1]))
 sys.exit(0 if m["bad_pixels"] <= 2 else 1)
 EOF
+fi
+
+# Each ray's reach: no pixel of the glass beside a mirror is left unbounded
+# or on an estimate, on the GPU or on the CPU.
+if [ "$k" -eq 1 ]; then
+  for backend in "" --cpu; do
+    "$SNELL" render "$SOURCE/scenes/hard/glass-beside-mirror.scn" $backend --size 32 -q --stats \
+      -o "$work/reach.pfm" >"$work/stats" 2>"$work/err" || bad "glass beside a mirror ($backend) did not render"
+    unbounded=$(grep -o '"unbounded_pixels": [0-9]*' "$work/stats" | grep -o '[0-9]*$')
+    estimated=$(grep -o '"estimated_pixels": [0-9]*' "$work/stats" | grep -o '[0-9]*$')
+    [ "${unbounded:-x}" = 0 ] && [ "${estimated:-x}" = 0 ] && ok ||
+      bad "glass beside a mirror ($backend): $unbounded unbounded, $estimated estimated pixels"
+  done
 fi
 
 echo "tree tests ($part: ${#mine[@]} scenes): $pass passed, $fail failed"

@@ -20,6 +20,7 @@ inline VkDescriptorType descriptorType(std::uint32_t binding) {
     case SNELL_BINDING_MATERIALS:
     case SNELL_BINDING_LIGHTS:
     case SNELL_BINDING_BVH:
+    case SNELL_BINDING_REACH:
     case SNELL_BINDING_SPHERES_LOW:
     case SNELL_BINDING_ELLIPSOIDS_LOW:
     case SNELL_BINDING_LIGHTS_LOW: return VK_DESCRIPTOR_TYPE_UNIFORM_TEXEL_BUFFER;

@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "bvh/Bvh.h"
+#include "render/Reach.h"
 #include "render/Truncation.h"
 
 namespace snell::gpu {
@@ -16,6 +17,16 @@ namespace {
 
 vec4 toVec4(const snell::dvec3& v, double w) {
     return vec4(static_cast<float>(v.x), static_cast<float>(v.y), static_cast<float>(v.z), static_cast<float>(w));
+}
+
+// v in float, each channel rounded up (+inf stays +inf): a bound stays one.
+vec4 roundedUp(const snell::dvec3& v) {
+    vec4 r(0.0f);
+    for (int k = 0; k < 3; ++k) {
+        r[k] = static_cast<float>(v[k]);
+        if (double(r[k]) < v[k]) r[k] = std::nextafter(r[k], std::numeric_limits<float>::infinity());
+    }
+    return r;
 }
 
 // v and w as float pairs: hi gets the rounded values, lo what rounding lost.
@@ -227,6 +238,24 @@ GpuScene buildGpuScene(const snell::Scene& scene, const snell::Camera& camera, P
         out.traps = out.traps || traps[i];
     }
     out.amplifying = scene.anyAmplifying();
+    // Each sphere's reach, in the GPU's order, where some is below R: leaving
+    // a sphere, or entering one that refracts (only an eye inside sends rays
+    // into the others).
+    const snell::RadianceBound radiance = snell::radianceBound(scene);
+    const snell::ReachBound reach = snell::reachBound(scene, radiance);
+    bool below = false;
+    for (std::size_t i = 0; i < scene.spheres.size(); ++i) {
+        const bool refracts = scene.materials[scene.spheres[i].material].refracts();
+        for (int c = 0; c < 3; ++c)
+            below = below || reach.outward[i][c] < radiance.radiance[c] ||
+                    (refracts && reach.inward[i][c] < radiance.radiance[c]);
+    }
+    if (below) {
+        out.reach.reserve(order.size());
+        for (std::uint32_t index : order)
+            out.reach.push_back({roundedUp(reach.outward[index]), roundedUp(reach.inward[index])});
+        out.hollow = reach.hollow;
+    }
     for (const snell::Light& l : scene.lights) {
         Light light{}, low{};
         splitVec4(l.position - eye, 1.0, light.position, low.position);
@@ -281,6 +310,7 @@ FrameParams makeFrameParams(const snell::Scene& scene, const GpuScene& gpuScene,
     f.sphereCount = static_cast<uint>(gpuScene.spheres.size());
     f.lightCount = static_cast<uint>(gpuScene.lights.size());
     f.bvhNodeCount = static_cast<uint>(gpuScene.nodes.size());
+    f.reachInward = !gpuScene.reach.empty() && snell::inwardHolds(scene, gpuScene.hollow, camera.eye) ? 1u : 0u;
     return f;
 }
 

@@ -29,16 +29,17 @@ static_assert(offsetof(FrameParams, cornerDir) == 16 &&
               offsetof(FrameParams, bvhNodeCount) == 152 && offsetof(FrameParams, sampleCount) == 160 &&
               offsetof(FrameParams, minWeight) == 172 && offsetof(FrameParams, airEta) == 184 &&
               offsetof(FrameParams, bvhAddressLow) == 188 && offsetof(FrameParams, rayStackAddressLow) == 196 &&
-              offsetof(FrameParams, mediaStackAddressLow) == 204 && offsetof(FrameParams, lights) == 224 &&
-              sizeof(FrameParams) == 224 + 32 * SNELL_FRAME_LIGHTS);
+              offsetof(FrameParams, mediaStackAddressLow) == 204 && offsetof(FrameParams, reachInward) == 224 &&
+              offsetof(FrameParams, lights) == 240 && sizeof(FrameParams) == 240 + 32 * SNELL_FRAME_LIGHTS);
 static_assert(sizeof(TileParams) == 32 && offsetof(TileParams, resume) == 16 &&
               offsetof(TileParams, workgroupStride) == 20 && offsetof(TileParams, strideY) == 28);
-static_assert(sizeof(SlotState) == 240 && offsetof(SlotState, sampleLight) == 192 &&
+static_assert(sizeof(SlotState) == 256 && offsetof(SlotState, sampleLight) == 192 && offsetof(SlotState, deferredLight) == 240 &&
               offsetof(SlotState, flaggedLow) == 224 && offsetof(SlotState, lost) == 32 && offsetof(SlotState, undecided) == 96 &&
               offsetof(SlotState, pixel) == 112 && offsetof(SlotState, finished) == 124 &&
               offsetof(SlotState, treeRays) == 128 && offsetof(SlotState, rays) == 136 &&
               offsetof(SlotState, frontierOld) == 152 && offsetof(SlotState, cutOff) == 160 &&
               offsetof(SlotState, settledWeight) == 176);
+static_assert(sizeof(SphereReach) == 32 && offsetof(SphereReach, inward) == 16);
 static_assert(sizeof(FlaggedSamples) == 32 && offsetof(FlaggedSamples, high) == 20);
 static_assert(sizeof(OutputPixel) == 32 && offsetof(OutputPixel, estimate) == 16 &&
               offsetof(OutputPixel, report) == 20 && offsetof(OutputPixel, moved) == 28);
@@ -73,6 +74,10 @@ struct GpuScene {
     std::vector<Material> materials;
     std::vector<Light> lights;
     std::vector<BvhNode> nodes;  // empty when no BVH is used
+    // Each sphere's reach (render/Reach.h), rounded up to float; empty where
+    // no sphere's is below R, and every ray's light is bounded by R.
+    std::vector<SphereReach> reach;
+    std::vector<bool> hollow;  // ReachBound::hollow, in the scene's order, for inwardHolds
     // With sphereBoxes asked for and a BVH: each sphere's box, in sphere
     // order, rounded outwards and padded for a float ray-box test.
     std::vector<SphereBox> sphereBoxes;

@@ -130,6 +130,7 @@ void specialiseToScene(const GpuScene& layout, const KernelPolicy& policy, Speci
         std::clamp<std::size_t>(layout.refractiveSpheres, 1, SNELL_MAX_MEDIA_LIMIT));
     values[SNELL_SPEC_AMPLIFYING] = layout.amplifying;
     values[SNELL_SPEC_TRAPS] = layout.traps;
+    values[SNELL_SPEC_REACH] = !layout.reach.empty();
 }
 
 }  // namespace

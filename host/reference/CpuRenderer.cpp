@@ -131,8 +131,9 @@ struct CpuRenderer::Children {
 // (`frontier`, which a lower cut-off continues from); how many rays they traced
 // and how deep they went.
 struct CpuRenderer::TreeTrace {
-    dvec3 lost{0.0};
+    dvec3 lost{0.0};              // the most light of the rays lost
     dvec3 deferred{0.0};          // the weight of the rays in `frontier`
+    dvec3 deferredLight{0.0};     // and the most light they can bring (render/Reach.h)
     double heaviestDeferred = 0.0;
     std::vector<PendingRay> frontier;
     std::uint64_t rays = 0;
@@ -141,11 +142,14 @@ struct CpuRenderer::TreeTrace {
     bool overBudget = false;
     bool amplified = false;       // a hit met a trap (growthTraps) with light of a gain > 1
     const std::vector<bool>* traps = nullptr;  // per material (growthTraps)
+    const RadianceBound* radiance = nullptr;
+    const ReachBound* reach = nullptr;
+    bool inwardHolds = false;  // reach->inward holds for this render's eye
     bool anyTrap = false;
     // Where a decision was undecided (Margins.h): the weight of the rays whose
     // light either outcome may change (each by at most its weight times R),
     // and the light of terms that may be off (shadow rays, shading's rounding).
-    dvec3 undecidedWeight{0.0};
+    dvec3 undecidedReach{0.0};  // of rays: their weights times their reach
     dvec3 undecidedLight{0.0};
     bool undecided = false;
     // The light the pixel's sum holds that the exact tree's may not, largest
@@ -162,9 +166,21 @@ struct CpuRenderer::TreeTrace {
     // Ray r's light below this point may be either outcome's.
     void widen(PendingRay& r, const dvec3& weight) {
         undecided = true;
-        if (!r.covered) undecidedWeight += weight;
+        if (!r.covered) undecidedReach += weighted(weight, reachOf(r));
         r.covered = true;
     }
+
+    // The most light ray r can bring, per unit weight (render/Reach.h): by
+    // where it starts, or R for a camera ray and one whose light may be
+    // either outcome's of an undecided decision.
+    dvec3 reachOf(const PendingRay& r) const {
+        return r.covered || r.fromSphere == kNone ? radiance->radiance : sphereReach(r.fromSphere, r.inward);
+    }
+    dvec3 sphereReach(std::uint32_t sphere, bool inward) const {
+        if (!inward) return reach->outward[sphere];
+        return inwardHolds ? reach->inward[sphere] : radiance->radiance;
+    }
+    void lose(const PendingRay& r) { lost += weighted(r.weight, reachOf(r)); }
 
     // A ray under the cut-off: the next, lower cut-off starts from it (under
     // the floor no cut-off will, and it is lost; but in a scene with traps a
@@ -174,10 +190,11 @@ struct CpuRenderer::TreeTrace {
         if (!(m > 0.0)) return;
         const bool mayGoBelowFloor = anyTrap && settings.treeBudget != 0;
         if (!(settings.tolerance > 0.0) || (m < settings.minWeight && !mayGoBelowFloor)) {
-            lost += r.weight;
+            lose(r);
             return;
         }
         deferred += r.weight;
+        deferredLight += weighted(r.weight, reachOf(r));
         heaviestDeferred = std::max(heaviestDeferred, m);
         frontier.push_back(std::move(r));
     }
@@ -186,6 +203,7 @@ struct CpuRenderer::TreeTrace {
 CpuRenderer::CpuRenderer(const Scene& scene) : scene_(scene) {
     amplifying_ = scene.anyAmplifying();
     radiance_ = radianceBound(scene);
+    reach_ = reachBound(scene, radiance_);
     useBvh_ = scene.spheres.size() > kBvhThreshold;
     if (useBvh_) {
         std::vector<Aabb> bounds;
@@ -195,12 +213,14 @@ CpuRenderer::CpuRenderer(const Scene& scene) : scene_(scene) {
     }
 }
 
-std::shared_ptr<const std::vector<bool>> CpuRenderer::trapsFor(const dvec3& eye) const {
+std::shared_ptr<const std::vector<bool>> CpuRenderer::trapsFor(const dvec3& eye, bool& inward) const {
     const std::lock_guard<std::mutex> lock(trapsMutex_);
     if (!traps_ || trapsEye_ != eye) {
         traps_ = std::make_shared<const std::vector<bool>>(growthTraps(scene_, eye));
+        inwardHolds_ = inwardHolds(scene_, reach_.hollow, eye);
         trapsEye_ = eye;
     }
+    inward = inwardHolds_;
     return traps_;
 }
 
@@ -373,7 +393,7 @@ bool CpuRenderer::admitRay(PendingRay& r, const dvec3& pixelSum, double saturati
     }
     if (tree.budget != 0 && tree.rays >= tree.budget) {
         tree.overBudget = true;
-        tree.lost += r.weight;
+        tree.lose(r);
         return false;
     }
     ++tree.rays;
@@ -389,7 +409,7 @@ void CpuRenderer::followChildren(const PendingRay& r, const Hit& hit, double cut
                                  TreeTrace& tree, std::vector<PendingRay>& stack) const {
     const dvec3 gain = childrenGain(*hit.material, settings);
     if (r.depth >= settings.maxDepth) {
-        tree.lost += weighted(r.weight, gain);
+        tree.lost += weighted(weighted(r.weight, gain), radiance_.radiance);
         return;
     }
     // Light carried into a material that traps it (SPEC §4 amplifying
@@ -404,9 +424,10 @@ void CpuRenderer::followChildren(const PendingRay& r, const Hit& hit, double cut
     Children c = children(r, hit, settings);
     if (c.undecided && !r.covered) {
         // Reflected or refracted: either outcome's children carry light
-        // within their weights times R.
+        // within their weights times R (as the shader, whose followChildren
+        // does not read their sphere's reach).
         tree.undecided = true;
-        tree.undecidedWeight += weighted(r.weight, gain);
+        tree.undecidedReach += weighted(weighted(r.weight, gain), radiance_.radiance);
         c.reflected.covered = true;
         if (c.refracted) c.refracted->covered = true;
     }
@@ -484,9 +505,13 @@ CpuRenderer::Pixel CpuRenderer::renderPixel(const RenderRequest& request, int x,
     dvec3 sum(0.0);
     TreeTrace tree;
     tree.budget = settings.treeBudget * std::uint64_t(count);
-    const std::shared_ptr<const std::vector<bool>> traps = trapsFor(request.camera.eye);
+    bool inward = false;
+    const std::shared_ptr<const std::vector<bool>> traps = trapsFor(request.camera.eye, inward);
     tree.traps = traps.get();
     tree.anyTrap = std::find(traps->begin(), traps->end(), true) != traps->end();
+    tree.radiance = &radiance_;
+    tree.reach = &reach_;
+    tree.inwardHolds = inward;
     const bool continues = settings.tolerance > 0.0;
     for (int k = first; k < first + all; ++k) {
         if (!traced(k)) continue;
@@ -495,7 +520,7 @@ CpuRenderer::Pixel CpuRenderer::renderPixel(const RenderRequest& request, int x,
                   continues ? std::max(settings.minWeight, kFirstRung) : settings.minWeight, settings, counts, tree);
     }
     for (;;) {
-        estimate.add(radiance_, sum, tree.lost + tree.deferred, samples);
+        estimate.add(sum, tree.lost + tree.deferredLight, samples);
         change.add(estimate.lower, tree.deferred * radiance_.local / samples);
         pixel.colour = estimate.lower;
         pixel.bound = estimate.bound();
@@ -504,17 +529,25 @@ CpuRenderer::Pixel CpuRenderer::renderPixel(const RenderRequest& request, int x,
         pixel.deepest = tree.deepest;
         const bool within = pixel.bound <= settings.tolerance;
         pixel.overTolerance = continues && !within;
+        const double error = change.error();
+        const bool estimateWithin =
+            settings.estimate && error <= settings.tolerance && (!tree.amplified || error <= kAmplifiedEstimate);
+        // A bounded pixel that ends over the tolerance states its estimate,
+        // where that is within it, beside its bound (set here, undone below
+        // where it goes on).
+        pixel.estimated = pixel.overTolerance && !pixel.unbounded && estimateWithin;
+        if (pixel.estimated) {
+            pixel.estimatedError = error;
+            pixel.overTolerance = false;
+        }
         // Done: certified; or nothing left under the cut-off (a lower one
         // would trace the same tree); or at the floor; or, where allowed, the
         // estimated error is within the tolerance.
         if (!continues || within || tree.frontier.empty()) break;
-        const double error = change.error();
         // Kept for the bound image: terms >= 0, so it holds for later, larger colours.
         pixel.estimatedError = error;
-        if (settings.estimate && pixel.unbounded && error <= settings.tolerance &&
-            (!tree.amplified || error <= kAmplifiedEstimate)) {
+        if (pixel.unbounded && estimateWithin) {
             pixel.estimated = true;
-            pixel.estimatedError = error;
             pixel.overTolerance = false;
             break;
         }
@@ -527,22 +560,24 @@ CpuRenderer::Pixel CpuRenderer::renderPixel(const RenderRequest& request, int x,
         const double cutOff = belowFloor ? rung : std::max(settings.minWeight, rung);
         // Everything left is under the floor, or the budget is spent.
         if (cutOff > tree.heaviestDeferred || !(cutOff >= std::numeric_limits<float>::min()) || tree.overBudget) break;
+        pixel.estimated = false;
+        pixel.overTolerance = continues;
         std::vector<PendingRay> waiting = std::move(tree.frontier);
         tree.frontier.clear();
-        tree.deferred = dvec3(0.0);
+        tree.deferred = tree.deferredLight = dvec3(0.0);
         tree.heaviestDeferred = 0.0;
         for (const PendingRay& r : waiting) traceTree(r, sum, saturation, cutOff, settings, counts, tree);
     }
     // Where a decision was undecided, or rounding may have moved a term, the
     // exact colour may lie on either side: the bound widens by that light
     // (Margins.h), and by the rounding of the sums and of the weights (each
-    // at most `deepest` + lights + a few rounded factors or terms). Where R
-    // is infinite an undecided ray's light has no bound: nor has the pixel,
+    // at most `deepest` + lights + a few rounded factors or terms). Where the
+    // reach is infinite an undecided ray's light has no bound: nor has the pixel,
     // but the clamp, and it claims no estimate.
     const double terms = tree.deepest + double(scene_.lights.size()) + 4.0;
     const double rounding =
         margins::kChain * kUnitRoundoff * terms * (maxComponent(glm::abs(pixel.colour)) + pixel.bound);
-    const dvec3 spread = weighted(tree.undecidedWeight, radiance_.radiance) + tree.undecidedLight;
+    const dvec3 spread = tree.undecidedReach + tree.undecidedLight;
     pixel.widening = maxComponent(spread) / samples + rounding;
     pixel.gap = maxComponent(estimate.upper - estimate.lower);
     // White whichever way its decisions went: the exact pixel is white too,

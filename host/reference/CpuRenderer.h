@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "bvh/Bvh.h"
+#include "render/Reach.h"
 #include "render/RenderRequest.h"
 #include "image/Image.h"
 #include "reference/Intersect.h"
@@ -94,17 +95,20 @@ private:
     void eachCandidate(const Ray& ray, Reach reach, Visit visit) const;
 
 
-    // growthTraps for a render's eye, kept for the next render from there.
-    std::shared_ptr<const std::vector<bool>> trapsFor(const glm::dvec3& eye) const;
+    // growthTraps for a render's eye, kept for the next render from there,
+    // and whether the reach's inward bounds hold for it (inwardHolds).
+    std::shared_ptr<const std::vector<bool>> trapsFor(const glm::dvec3& eye, bool& inwardHolds) const;
 
     const Scene& scene_;
     Bvh bvh_;
     bool useBvh_ = false;
     bool amplifying_ = false;
     RadianceBound radiance_;
+    ReachBound reach_;  // the light a ray can still bring, by where it starts
     mutable std::mutex trapsMutex_;
     mutable std::shared_ptr<const std::vector<bool>> traps_;
     mutable glm::dvec3 trapsEye_{0.0};
+    mutable bool inwardHolds_ = false;
 };
 
 }  // namespace snell

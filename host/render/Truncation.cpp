@@ -1,5 +1,7 @@
 #include "render/Truncation.h"
 
+#include "render/Placement.h"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -33,15 +35,11 @@ RadianceBound radianceBound(const Scene& scene) {
     return b;
 }
 
-void PixelEstimate::add(const RadianceBound& radiance, const glm::dvec3& sum, const glm::dvec3& dropped,
-                        double samples) {
+void PixelEstimate::add(const glm::dvec3& sum, const glm::dvec3& droppedLight, double samples) {
     for (int c = 0; c < 3; ++c) {
         const double value = sum[c] / samples;
-        // No light dropped, or none to drop in this channel: exact (0 · inf is 0).
-        const double lost = dropped[c] > 0.0 && radiance.radiance[c] > 0.0 ? dropped[c] * radiance.radiance[c] / samples
-                                                                           : 0.0;
         lower[c] = std::max(lower[c], value);
-        upper[c] = std::min(upper[c], value + lost);
+        upper[c] = std::min(upper[c], value + droppedLight[c] / samples);
     }
 }
 
@@ -80,35 +78,6 @@ double ErrorEstimate::error() const {
 }
 
 namespace {
-
-// A ball that holds a sphere or an ellipsoid: itself, or a centre and the
-// Frobenius norm of the linear part (at least its longest semi-axis).
-struct Ball {
-    glm::dvec3 centre{0.0};
-    double radius = 0.0;
-};
-Ball boundingBall(const Sphere& s) {
-    if (s.isTrueSphere) return {s.centre, s.radius};
-    double squares = 0.0;
-    for (int c = 0; c < 3; ++c) squares += glm::dot(glm::dvec3(s.worldFromObject[c]), glm::dvec3(s.worldFromObject[c]));
-    return {glm::dvec3(s.worldFromObject[3]), std::sqrt(squares)};
-}
-
-// How ball a lies against ball b: inside it, around it, apart, or their
-// surfaces cross (or touch, within rounding: treated as crossing).
-enum class Placement { Inside, Around, Apart, Crossing };
-Placement placement(const Ball& a, const Ball& b) {
-    const double d = glm::length(a.centre - b.centre);
-    const double margin = 1e-9 * (d + a.radius + b.radius);
-    if (d + a.radius < b.radius - margin) return Placement::Inside;
-    if (d + b.radius < a.radius - margin) return Placement::Around;
-    if (d > a.radius + b.radius + margin) return Placement::Apart;
-    return Placement::Crossing;
-}
-
-bool holds(const Ball& b, const glm::dvec3& point) {  // or nearly, as rounding has it
-    return glm::length(point - b.centre) <= b.radius * (1.0 + 1e-9);
-}
 
 // Sphere pairs the analysis looks at before it takes every sphere for a trap.
 constexpr double kMaxPairs = 1e8;

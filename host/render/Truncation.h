@@ -47,9 +47,10 @@ struct PixelEstimate {
     glm::dvec3 lower{0.0};  // the colour reported (unclamped)
     glm::dvec3 upper{std::numeric_limits<double>::infinity()};
 
-    // One step: `sum` its colour and `dropped` the weight of the rays it
-    // did not trace, both summed over `samples`.
-    void add(const RadianceBound& radiance, const glm::dvec3& sum, const glm::dvec3& dropped, double samples);
+    // One step: `sum` its colour and `droppedLight` the most light of the
+    // rays it did not trace (their weights times R, or each ray's own bound:
+    // render/Reach.h), both summed over `samples`.
+    void add(const glm::dvec3& sum, const glm::dvec3& droppedLight, double samples);
     // On the clamped colour; a channel whose upper bound is infinite is
     // bounded by 1 − lower only, and is `unbounded`.
     double bound() const;

@@ -139,7 +139,7 @@ void shadeLightsShared(inout SlotState state, Ray r, vec3 weight, Hit h, bool sh
                                   error);
             if ((blocked & mine) == 0u) addLight(state, r, weighted(weight, term), (undecided & mine) != 0u);
             if (DECISIONS && (blocked & mine) == 0u && !r.covered) addShadingError(state, maxChannel(weighted(weight, error)));
-            if ((undecided & mine) != 0u && !r.covered) addUndecided(state, vec4(vec3(0.0), maxChannel(weighted(weight, term))));
+            if ((undecided & mine) != 0u && !r.covered) addUndecided(state, vec4(vec3(0.0), maxChannel(weighted(weight, term))), vec3(0.0));
         }
     }
 }
@@ -181,7 +181,7 @@ bool shadeLights(inout SlotState state, inout Ray r, vec3 weight, Hit h, bool sh
             if (COUNT_RAYS && castShadowRay) countedRays[SNELL_COUNTER_SHADOW]++;
             if (castShadowRay) shadowRays++;
             addLight(state, r, weighted(weight, term), maxChannel(undecided) > 0.0);
-            if (DECISIONS && !r.covered) addUndecided(state, vec4(vec3(0.0), maxChannel(weighted(weight, undecided))));
+            if (DECISIONS && !r.covered) addUndecided(state, vec4(vec3(0.0), maxChannel(weighted(weight, undecided))), vec3(0.0));
             if (DECISIONS && !r.covered) addShadingError(state, maxChannel(weighted(weight, error)));
         }
     }

@@ -12,7 +12,7 @@ layout(set = 0, binding = SNELL_BINDING_OUTPUT, std430) writeonly buffer OutputB
 SlotState freshPixel(uint pixelIndex) {
     return SlotState(vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0), vec4(INFINITY), vec4(0.0), vec4(0.0), pixelIndex, 0u, 0u, 0u,
                      0u, 0u, 0u, 0u, 0u, 0u, 0u, 0u, firstCutOff, 0.0, INFINITY, INFINITY, 0.0, 0u, 0.0, 0.0,
-                     vec4(0.0), vec4(0.0), 0u, 0u, 0u, 0u);
+                     vec4(0.0), vec4(0.0), 0u, 0u, 0u, 0.0, vec4(0.0));
 }
 
 // Where a pixel's flagged samples go (BY_SAMPLE): beside its OutputPixel, at
@@ -41,14 +41,13 @@ void closeSample(inout SlotState state) {
 }
 
 // What a step of a pixel proves of its exact colour: its colour is a lower
-// bound and its colour plus the weight it has not traced times the radiance
-// bound an upper bound; the pixel keeps the best of each (render/Truncation.h,
+// bound and its colour plus the most light of the rays it has not traced
+// (each one's weight times its reach, rayReach) an upper bound; the pixel keeps the best of each (render/Truncation.h,
 // PixelEstimate, its twin). Returns the bound on the clamped colour.
 float addStep(inout SlotState state, float samples, out bool unbounded) {
     vec3 value = state.sum.rgb / samples;
-    vec3 notTraced = state.lost.rgb + state.deferred.rgb;
     state.lower.rgb = max(state.lower.rgb, value);
-    state.upper.rgb = min(state.upper.rgb, value + weighted(notTraced, frame.radiance.rgb) / samples);
+    state.upper.rgb = min(state.upper.rgb, value + (state.lost.rgb + state.deferredLight.rgb) / samples);
     vec3 gap = min(state.upper.rgb, vec3(1.0)) - min(state.lower.rgb, vec3(1.0));
     unbounded = any(bvec3(uvec3(greaterThan(state.upper.rgb, vec3(3.0e38))) & uvec3(lessThan(state.lower.rgb, vec3(1.0)))));
     return max(0.0, max(gap.r, max(gap.g, gap.b)));
@@ -120,6 +119,7 @@ float nextCutOff(SlotState state, StepOutcome o) {
 // The next step traces on from the rays this one left in the frontier.
 void beginStep(inout SlotState state) {
     state.deferred.rgb = vec3(0.0);
+    state.deferredLight.rgb = vec3(0.0);
     state.heaviestLeft = 0.0;
     state.frontierOld = state.frontierCount;
 }
@@ -127,21 +127,20 @@ void beginStep(inout SlotState state) {
 // What a pixel's undecided decisions and shading's rounding may have done to
 // its colour, a sample's mean, for its host (host/gpu/TileReadback.cpp: a
 // re-trace, a wider bound, or neither where the pixel is white either way):
-// `moved`, how far either way (its undecided rays' weight times R, where R is
-// finite in every channel they weigh, else times the most light one hit
-// returns; its undecided shadow rays' light; shading's rounding), and
+// `moved`, how far either way (its undecided rays' light, where finite in
+// every channel, else the most light one hit of them returns; its undecided
+// shadow rays' light; shading's rounding), and
 // `excess`, the light its sum holds that the exact one may not. Returns its
 // flags. Rounded up by 2^-20 of themselves: a few float operations' rounding.
 uint undecidedReport(SlotState state, out float excess, out float moved) {
     const float up = (1.0 + 1.0 / 1048576.0) / float(samples);
-    vec3 weight = state.undecided.rgb;
-    bvec3 weighs = greaterThan(weight, vec3(0.0));
-    bool unbounded = any(bvec3(uvec3(weighs) & uvec3(isinf(frame.radiance.rgb))));
-    float widening = maxChannel(mix(vec3(0.0), weight * frame.radiance.rgb, bvec3(uvec3(weighs) & uvec3(not(isinf(frame.radiance.rgb))))));
-    if (unbounded) widening = max(widening, maxChannel(weighted(weight, frame.localRadiance.rgb)));
+    vec3 light = state.undecided.rgb;
+    bool unbounded = any(isinf(light));
+    float widening = maxChannel(mix(light, vec3(0.0), isinf(light)));
+    if (unbounded) widening = max(widening, state.undecidedLocal);
     moved = (widening + state.undecided.a + state.shading) * up;
     excess = (state.unsureLight + state.shading) * up;
-    bool undecided = any(weighs) || state.undecided.a > 0.0;
+    bool undecided = maxChannel(light) > 0.0 || state.undecidedLocal > 0.0 || state.undecided.a > 0.0;
     return (undecided ? SNELL_PIXEL_UNDECIDED : 0u) | (undecided && unbounded ? SNELL_PIXEL_MOVED_UNBOUNDED : 0u);
 }
 
@@ -151,6 +150,10 @@ void finishPixel(uint slot, inout SlotState state, StepOutcome o, uint shadowRay
     // A pixel that dropped light that may grow, and has not saturated, has
     // neither a bound nor an estimate: it is over the tolerance, and says why.
     bool dropped = state.droppedGrowing != 0u && o.unbounded;
+    // A bounded pixel the floor stopped over the tolerance states its
+    // estimate, where that is within it, beside its bound.
+    o.settled = o.settled || (frame.estimate != 0u && !o.certified && !o.unbounded && o.estimate <= tolerance &&
+                              (state.amplified == 0u || o.estimate <= frame.amplifiedEstimate));
     bool overTolerance = tolerance > 0.0 && !o.certified && (!o.settled || dropped);
     uint flags = (state.overBudget != 0u ? SNELL_PIXEL_OVER_BUDGET : 0u) |
                  (overTolerance ? SNELL_PIXEL_OVER_TOLERANCE : 0u) | (dropped ? SNELL_PIXEL_DROPPED_GROWING : 0u);

@@ -6,11 +6,13 @@
 #define SNELL_SCHEDULE_TREE_GLSL
 
 // Light that undecided decisions may change (margins.glsl): `amount` is the
-// weight of the rays whose light either outcome may change (rgb), or the
-// light of undecided shadow rays (a). It flags the sample (BY_SAMPLE).
-void addUndecided(inout SlotState state, vec4 amount) {
+// most light of the rays of `weight` whose light either outcome may change
+// (rgb), or the light of undecided shadow rays (a). It flags the sample
+// (BY_SAMPLE).
+void addUndecided(inout SlotState state, vec4 amount, vec3 weight) {
     state.undecided += amount;
-    if (BY_SAMPLE && (maxChannel(amount.rgb) > 0.0 || amount.a > 0.0)) state.sampleFlagged = 1u;
+    state.undecidedLocal += maxChannel(weighted(weight, frame.localRadiance.rgb));
+    if (BY_SAMPLE && (maxChannel(weight) > 0.0 || amount.a > 0.0)) state.sampleFlagged = 1u;
 }
 // What shading's rounding may have moved of the light added.
 void addShadingError(inout SlotState state, float error) {
@@ -69,7 +71,7 @@ bool admitRay(uint slot, inout SlotState state, inout Ray r, float cutOff, out v
     // The pixel's trees past the budget: the rest of them is lost.
     if (!resuming && pixelBudget != 0u && state.treeRays >= pixelBudget) {
         state.overBudget = 1u;
-        state.lost.rgb += weight;
+        state.lost.rgb += weighted(weight, rayReach(r));
         return false;
     }
     if (!resuming) {
@@ -102,15 +104,17 @@ void noteGain(inout SlotState state, Hit h, vec3 gain, vec3 weight) {
 bool followChildren(uint slot, inout SlotState state, inout Ray r, vec3 weight, Hit h, float cutOff) {
     vec3 gain = childrenGain(h);
     if (r.depth >= frame.maxDepth) {
-        state.lost.rgb += weighted(weight, gain);
+        state.lost.rgb += weighted(weighted(weight, gain), frame.radiance.rgb);
         return false;
     }
     noteGain(state, h, gain, weight);
     Children c = children(r, weight, h);
     // Reflected or refracted within the margin: either answer's children
-    // carry light within their weights times R (margins.glsl).
+    // carry light within their weights times R (margins.glsl). (Their
+    // sphere's reach, read here, made Mesa 22.3 spill the kernel's state to
+    // memory it allocates at every dispatch: 40x the time under a loop budget.)
     if (DECISIONS && c.undecided && !r.covered) {
-        addUndecided(state, vec4(weighted(weight, gain), 0.0));
+        addUndecided(state, vec4(weighted(weighted(weight, gain), frame.radiance.rgb), 0.0), weighted(weight, gain));
         c.reflected.covered = true;
         c.refracted.covered = true;
     }
@@ -145,7 +149,7 @@ bool followChildren(uint slot, inout SlotState state, inout Ray r, vec3 weight, 
         if (TRAPS) state.droppedGrowing = 1u;  // as on a full frontier (deferRay)
     }
     if (both && !refractedWaits) {
-        if (stackFull) state.lost.rgb += reflectedWeight;
+        if (stackFull) state.lost.rgb += weighted(reflectedWeight, frame.radiance.rgb);
         else pushRay(slot, state.pending, c.reflected);  // with the parent's media, still current
     }
     // The refracted ray's medium stack replaces the parent's (kept when the
@@ -158,7 +162,7 @@ bool followChildren(uint slot, inout SlotState state, inout Ray r, vec3 weight, 
         return true;
     }
     if (!refracts) deferRay(slot, state, c.refracted);
-    else if (stackFull) state.lost.rgb += transmittedWeight;
+    else if (stackFull) state.lost.rgb += weighted(transmittedWeight, frame.radiance.rgb);
     else pushRay(slot, state.pending, c.refracted);
     // The reflected ray goes on (if it is traced at all), with the parent's media.
     [[unroll]] for (int k = 0; k < MAX_MEDIA; ++k) media[k] = parentMedia[k];
