@@ -6,6 +6,7 @@
 #include <numbers>
 
 #include "reference/Intersect.h"
+#include "render/Margins.h"
 #include "scene/Parser.h"
 #include "scene/Transform.h"
 
@@ -260,6 +261,36 @@ TEST(Refraction, ReflectDirectionByHand) {
     expectNear(snell::reflectDirection({1, 0, 0}, glm::normalize(dvec3(-1, 1, 0))), {0, 1, 0}, 1e-15);
     // Grazing: tangent direction is unchanged.
     expectNear(snell::reflectDirection({1, 0, 0}, {0, 1, 0}), {1, 0, 0});
+}
+
+// ---------------------------------------------------------------- margins
+
+// The most Phong's factor max(0, c)^p moves for c within delta of rv (SPEC
+// §4.3): it is monotone in c, so at one end of the interval.
+double specularSpread(double rv, double p, double delta) {
+    auto factor = [p](double c) { return c > 0.0 ? std::pow(std::min(c, 1.0), p) : 0.0; };
+    const double at = factor(rv);
+    return std::max(factor(rv + delta) - at, at - factor(rv - delta));
+}
+
+TEST(Margins, SpecularOffCoversTheWholeInterval) {
+    // Where p·δ/rv is not small the slope p·rv^(p−1)·δ understates how far
+    // the factor may rise (it is convex): a mirror's exponent of 1e5 with R·V
+    // tilted by 1e-4 may light a highlight the computed ray misses.
+    const double exponents[] = {0.0, 0.3, 1.0, 3.0, 100.0, 1e5};
+    const double deltas[] = {1e-9, 1e-6, 1e-4, 1e-2};
+    const double cosines[] = {-1e-3, -1e-7, 1e-8, 1e-3, 0.3, 0.9, 0.9999, 1.0 - 1e-6};
+    for (double p : exponents)
+        for (double delta : deltas)
+            for (double rv : cosines) {
+                const double factor = rv > 0.0 ? std::pow(rv, p) : 0.0;
+                const double off = snell::margins::specularOff(rv, p, delta, factor, 0.0);
+                EXPECT_GE(off * (1.0 + 1e-12) + 1e-15, specularSpread(rv, p, delta)) << "p " << p << " delta " << delta << " rv " << rv;
+                EXPECT_LE(off, 1.0);
+            }
+    // Where p·δ/rv is small it is the slope, to first order.
+    const double rv = 0.9, p = 10.0, delta = 1e-8;
+    EXPECT_NEAR(snell::margins::specularOff(rv, p, delta, std::pow(rv, p), 0.0), p * std::pow(rv, p - 1.0) * delta, 1e-14);
 }
 
 }  // namespace

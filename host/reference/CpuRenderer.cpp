@@ -310,14 +310,14 @@ dvec3 CpuRenderer::shadeLight(const Light& light, const Hit& hit, const dvec3& v
     const double specular = rv > 0.0 ? std::pow(rv, m.phong) : 0.0;
     const dvec3 term = light.colour * (m.kd * nl + m.ks * specular);
     // Either side of a shadow's edge; and N·L and R·V off by the normal's and
-    // the direction's uncertainty: kd·δ, and p (R·V)^(p−1) δ for (R·V)^p.
+    // the direction's uncertainty: kd·δ, and (R·V)^p's (Margins.h, specularOff).
     if (undecided) {
         uncertain.light += term;
         uncertain.undecided = true;
         if (!blocked) uncertain.excess += term;
     }
     const double cosineOff = 2.0 * (hit.normalOff + toLight.tilt) + hit.viewTilt + margins::kChain * kUnitRoundoff;
-    const double specularOff = rv > 0.0 ? specular * m.phong * cosineOff / rv : 0.0;
+    const double specularOff = margins::specularOff(rv, m.phong, cosineOff, specular, 0.0);
     if (!blocked) {
         const dvec3 error = light.colour * (m.kd * cosineOff + m.ks * specularOff);
         uncertain.light += error;

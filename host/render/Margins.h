@@ -1,11 +1,11 @@
-// The margins of the decisions rounding can flip (docs/accuracy.md, "Decisions
-// and their margins"). A computed ray stands for an exact one of SPEC §4's
-// tree; it may be off by `spread` at its origin (world units) and by `tilt`
-// in its direction (radians), from the rounding of every step before it. A
-// decision (which sphere is nearer, hit or miss, inside or outside, total
-// internal reflection, a shadow ray blocked) is *undecided* when the exact
-// ray's answer could differ: when the quantity it tests is within its margin
-// of the boundary. First-order forward error analysis (Higham, "Accuracy and
+// The margins of the decisions rounding can flip (docs/decisions.md). A
+// computed ray stands for an exact one of SPEC §4's tree; it may be off by
+// `spread` at its origin (world units) and by `tilt` in its direction
+// (radians), from the rounding of every step before it. A decision (which
+// sphere is nearer, hit or miss, inside or outside, total internal
+// reflection, a shadow ray blocked) is *undecided* when the exact ray's
+// answer could differ: when the quantity it tests is within its margin of
+// the boundary. First-order forward error analysis (Higham, "Accuracy and
 // Stability of Numerical Algorithms", ch. 3), each operation chain rounding
 // at most kChain units; `unit` is the unit roundoff of the arithmetic (2^-53
 // for double, 2^-24 for float). The twin for the shader is
@@ -64,6 +64,24 @@ inline double reflectionMargin(double eta, double cosineOff, double unit) {
     return 2.0 * eta * eta * cosineOff + kChain * unit * (1.0 + eta * eta);
 }
 
+// How far Phong's specular factor (R·V)^p (0 where R·V <= 0, SPEC §4.3) may
+// be from the exact one, with R·V = rv off by `cosineOff` = δ and `specular`
+// the factor computed from rv. The factor grows with R·V, so the exact one
+// lies between the ends' values. With x = δ/rv: above, (1 + x)^p <= e^(px)
+// (log(1 + x) <= x), which is within specular·px(1 + px) while px < 1/2 (the
+// slope p·rv^(p−1)·δ understates it beyond); past that, the upper end's value
+// itself, (rv + δ)^p, bounds the move. Below, by at most specular·max(p, 1)·x
+// (Bernoulli; (1 − x)^p >= 1 − x for p < 1). Never more than 1: the exact
+// factor lies in [0, 1]. `logOff`: the absolute error the arithmetic allows
+// log2 near 1 (0 for the CPU's pow; 2^-21 in Vulkan), which p multiplies.
+inline double specularOff(double rv, double p, double cosineOff, double specular, double logOff) {
+    const double top = rv + cosineOff;
+    const double x = cosineOff / rv, a = p * (x + logOff);
+    if (!(rv > 0.0) || !(a < 0.5))
+        return top > 0.0 ? std::min(1.0, std::pow(std::min(top, 1.0), p) * std::exp2(p * logOff) * (1.0 + 1e-10)) : 0.0;
+    return std::min(1.0, specular * std::max(a * (1.0 + a), std::min(1.0, std::max(p, 1.0) * x)));
+}
+
 // How far a hit's outward normal may be off: the hit point's offset times how
 // fast the normal turns there (1/r on a true sphere; CpuRenderer::outwardNormal).
 inline double normalOff(double pointOff, double curvature, double unit) { return pointOff * curvature + kChain * unit; }
@@ -77,7 +95,7 @@ inline double normalOff(double pointOff, double curvature, double unit) { return
 // every bounce of an orbit inside a sphere, it would compound until after a
 // few dozen bounces it said "anything". There the normal turns with the
 // point's own rounding only: a first-order model, not a bound on long orbits
-// (docs/accuracy.md, "Decisions").
+// (docs/decisions.md).
 // Inside, the origin's offset is carried along the ray as it is (not
 // amplified by the angle the ray meets the surface at either).
 // `offset`: the point's whole offset (Closest::margin and rounding); t: the

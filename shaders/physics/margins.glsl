@@ -20,6 +20,19 @@ real facingMargin(real tilt, real normalOff) { return tilt + normalOff + CHAIN *
 real reflectionMargin(real eta, real cosineOff) {
     return 2.0 * eta * eta * cosineOff + CHAIN * UNIT_ROUNDOFF * (1.0 + eta * eta);
 }
+// Phong's (R·V)^p off by at most this, R·V = rv off by cosineOff (Margins.h,
+// specularOff: within specular·px(1 + px) above while px < 1/2, else the
+// upper end's value itself; not the slope, which understates a convex rise).
+float specularOffset(float rv, float p, float cosineOff, float specular, float logOff) {
+    float x = cosineOff / rv, a = p * (x + logOff);
+    bool slope = rv > 0.0 && a < 0.5;
+    float offset = slope ? specular * max(a * (1.0 + a), min(1.0, max(p, 1.0) * x)) : 0.0;
+    // Rare (R·V within δ of 0, or p·δ/R·V large): a branch, so that rows of
+    // lanes with none skip the pow.
+    float top = rv + cosineOff;
+    [[dont_flatten]] if (!slope && top > 0.0) offset = pow(min(top, 1.0), p) * exp2(p * logOff) * (1.0 + 1e-5);
+    return min(1.0, offset);
+}
 real normalOffset(real pointOff, real turning) { return pointOff * turning + CHAIN * UNIT_ROUNDOFF; }
 
 // How fast the normal n = A x of the quadric xᵀ A x = 1 turns as x moves

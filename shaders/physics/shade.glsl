@@ -14,9 +14,9 @@ vec3 ambientTerm(Hit h) { return frame.ambient.rgb * h.kd.rgb; }
 // seen: l, the unit vector towards it, with n·l = nl > 0; v towards the eye.
 // `error`: how far it may be from the exact term, N·L and R·V being off by
 // cosineOff (the normal's and the light direction's uncertainty, and float
-// rounding): kd·δ, and for (R·V)^p, p (R·V)^(p−1) δ plus pow's own error.
-// pow is exp2(y), y = p log2(R·V): Vulkan allows log2 an absolute 2^-21 near
-// 1, which p multiplies, and exp2 3 + 2|y| ULP (1 ULP <= 2u), which is at
+// rounding): kd·δ, and (R·V)^p's (margins.glsl, specularOffset) plus pow's own
+// error. pow is exp2(y), y = p log2(R·V): Vulkan allows log2 an absolute 2^-21
+// near 1, which p multiplies, and exp2 3 + 2|y| ULP (1 ULP <= 2u), which is at
 // most 2u x^p + 4u |y| 2^y <= x^p 8u + 9u, as |y| 2^y <= 1/(e ln 2) for y <= 0.
 // CpuRenderer::shadeLight's twin.
 vec3 lightTerm(uint j, Hit h, rvec3 l, float nl, rvec3 v, float cosineOff, out vec3 error) {
@@ -24,7 +24,7 @@ vec3 lightTerm(uint j, Hit h, rvec3 l, float nl, rvec3 v, float cosineOff, out v
     float rv = float(dot(2.0 * dot(h.normal, l) * h.normal - l, v));
     float p = h.kd.w;
     float specular = rv > 0.0 ? pow(rv, p) : 0.0;
-    float specularOff = rv > 0.0 ? specular * (p * (cosineOff / rv + 4.8e-7) + 8.0 * u) + 9.0 * u : 0.0;
+    float specularOff = specularOffset(rv, p, cosineOff, specular, 4.8e-7) + specular * 8.0 * u + 9.0 * u;
     error = lightColour(j) * (h.kd.rgb * cosineOff + h.ks.rgb * specularOff);
     return lightColour(j) * (h.kd.rgb * nl + h.ks.rgb * specular);
 }
