@@ -3,7 +3,7 @@
 
     python3 bench/summarize.py bench/results/bench.json [--plot bench/results/bench.png]
 
-prints the Markdown tables of docs/performance-log.md (with the price of the
+prints the Markdown tables of docs/log/benchmark.md (with the price of the
 default: its time over that of the fastest fixed tree as accurate) and, with --plot, draws
 speed against error: a panel per scene, dispatch time (ms) against the mean
 error (in 1/255) of each setting measured against the limit reference (dots,

@@ -5,7 +5,7 @@
 // renderer's own walk (bvh_walk.glsl) and intersection (intersect.glsl); no
 // shading, no ray tree, no pixel scheduling. `snell bench` sets its time
 // beside the renderer's at --depth 0 on the same BVH scene, which casts the
-// same rays (docs/performance-log.md, "The walk's floor").
+// same rays (docs/log/bvh-walk.md, "The walk's floor").
 #version 460
 #extension GL_GOOGLE_include_directive : require
 #extension GL_EXT_control_flow_attributes : require

@@ -9,7 +9,7 @@
 // struct below a run of RGBA32 texels (its vec4 members in order): texel
 // fetches gather a SIMD row's values in one vectorised step on lavapipe, about
 // 3x cheaper than the bounds-checked per-lane loads of a storage buffer
-// (docs/performance-log.md, "What lavapipe charges for"), and they count elements (2^27 texels on lavapipe), so
+// (docs/log/drivers-and-kernel.md, "What lavapipe charges for"), and they count elements (2^27 texels on lavapipe), so
 // the documented limit of 4 000 000 spheres fits where 128 MiB of storage
 // buffer does not. Every view is RGBA32UI: integers are read as they are,
 // floats by their bits (uintBitsToFloat), exact either way. The
@@ -18,7 +18,7 @@
 // a function for every texel fetch, which in the walk's seven fetches a node
 // costs more than loads; and it loads from an address without the per-lane
 // bounds checks of a storage buffer, nor its 128 MiB limit, each word as two
-// 64-bit halves (wide_words.glsl; docs/performance-log.md, "The BVH as a storage
+// 64-bit halves (wide_words.glsl; docs/log/bvh-walk.md, "The BVH as a storage
 // buffer", "The walk's floor", "Words loaded as 64-bit halves").
 #ifndef SNELL_SHARED_LAYOUT_H
 #define SNELL_SHARED_LAYOUT_H
@@ -290,7 +290,7 @@ struct FlaggedSamples {
 // needs and no more. Each byte is written by the kernel and read again by the
 // host: at 64 bytes (the undecided weights and rounding terms as they were
 // summed, the host working out the rest) the dispatch of a scene of a few
-// spheres took 1.05-1.2x as long on lavapipe (docs/performance-log.md).
+// spheres took 1.05-1.2x as long on lavapipe (docs/log/margins.md, "eighth").
 struct OutputPixel {
     vec4 colour;    // rgb: the colour (unclamped); a: its truncation bound, negative where not finite
     float estimate; // the estimated error where it stopped on one (render/Truncation.h), else −1
@@ -386,7 +386,7 @@ struct FrameParams {
 // SIMD row's width and its rows one by one: runs that fine keep the tiles
 // fair samples of a finely structured image (runs of 64 columns left the
 // tiles of becker-SphereFlake2 at 1400² 16 against 29 s), and cost the
-// kernel no more than coarse ones (docs/performance-log.md, "Interleaved tiles").
+// kernel no more than coarse ones (docs/log/writing-images.md, "Interleaved tiles").
 #define SNELL_TILE_COLUMN_RUN 8
 #define SNELL_TILE_ROW_RUN 1
 

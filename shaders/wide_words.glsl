@@ -2,7 +2,7 @@
 // per-lane addresses lavapipe gathers (and scatters) each component of a
 // value on its own, so a word read as u64vec2 costs two gathers where a uvec4
 // costs four: on Mesa 25 the BVH walk's floor ran 1.2–1.3× faster so
-// (docs/performance-log.md, "Words loaded as 64-bit halves"). Needs shaderInt64.
+// (docs/log/kernel-profiled.md, "Words loaded as 64-bit halves"). Needs shaderInt64.
 #ifndef SNELL_WIDE_WORDS_GLSL
 #define SNELL_WIDE_WORDS_GLSL
 #extension GL_ARB_gpu_shader_int64 : require

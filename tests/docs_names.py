@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Every file and symbol that README.md and docs/*.md name in backticks exists.
+"""Every file and symbol that README.md, docs/*.md and docs/log/*.md name in backticks exists.
 
     python3 tests/docs_names.py SOURCE
 
@@ -186,7 +186,8 @@ def check_doc(doc):
                                         + ", ".join(os.path.relpath(p, source) for p in files))
 
 
-docs = [os.path.join(source, "README.md")] + sorted(glob.glob(os.path.join(source, "docs", "*.md")))
+docs = [os.path.join(source, "README.md")] + sorted(glob.glob(os.path.join(source, "docs", "*.md"))) + sorted(
+    glob.glob(os.path.join(source, "docs", "log", "*.md")))
 for doc in docs:
     check_doc(doc)
 for p in problems:

@@ -4,7 +4,7 @@
 # every subcommand `snell --help` lists, no builder's paths, and renders
 # without warnings; the bash completion offers every subcommand;
 # docs/scene-format.md names every command of the scene format and its
-# example scene parses; every file and symbol that README.md and docs/*.md
+# example scene parses; every file and symbol that README.md, docs/*.md and docs/log/*.md
 # name in backticks exists (tests/docs_names.py); and the man page's example
 # commands run.
 #   SNELL=build/snell DOCS=build/docs SOURCE=. bash tests/docs_test.sh

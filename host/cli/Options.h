@@ -106,7 +106,7 @@ std::string pipelineCachePath();
 vk::FaultInjection faultInjection();
 std::uint32_t loopBudgetOverride();
 // False where SNELL_DECISIONS=off asks for a kernel that keeps no rounding
-// margins (measuring what they cost: docs/accuracy.md).
+// margins (measuring what they cost: docs/decisions.md).
 bool decisionsKept();
 
 }  // namespace snell::cli

@@ -366,7 +366,7 @@ RenderOutcome RenderCommand::renderOnGpu(const Scene& scene, RenderRequest& requ
         if (const std::uint32_t budget = loopBudgetOverride()) rendererOptions.loopBudget = budget;
         rendererOptions.decisions = decisionsKept();
         // Pixels whose float decisions stay undecided are traced again in
-        // double by the CPU reference (docs/accuracy.md, "Decisions").
+        // double by the CPU reference (docs/decisions.md).
         request.retrace = cpuRetrace(scene, request);
         rendererOptions.countLanes = o_.countLanes;
         ComputeRenderer renderer(context, scene, request.camera, rendererOptions);

@@ -64,7 +64,7 @@ public:
     // the image is streamed once all are done. Otherwise blocks, streamed a
     // band of rows at a time. Interleaving cost 6–12 % where workgroups keep
     // to their own shares (no refraction, no BVH), nothing measurable where
-    // they help each other (docs/performance-log.md, "Interleaved tiles").
+    // they help each other (docs/log/writing-images.md, "Interleaved tiles").
     static constexpr int kMaxInterleavedSide = gpu::kMaxInterleavedSide;
     static bool interleaves(const PixelWindow& area) { return gpu::interleaves(area); }
     // The tiles render() traces `area` in, in that order; its progress

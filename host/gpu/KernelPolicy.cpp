@@ -24,7 +24,7 @@ bool choosesRayQueries(const vk::Context& context, RendererOptions& options) {
         if (options.bvh == BvhMode::Auto) options.bvh = BvhMode::On;
     }
     // Auto takes the device's traversal on GPUs only: on lavapipe snell's walk
-    // measured faster (docs/performance-log.md, "The device's ray traversal").
+    // measured faster (docs/log/real-gpu.md, "The device's ray traversal").
     return options.precision == Precision::Fp32 && context.rayQueriesEnabled() &&
            (options.traversal == Traversal::RayQuery ||
             (options.traversal == Traversal::Auto && !context.isCpuDevice()));
@@ -36,14 +36,14 @@ KernelPolicy devicePolicy(vk::Context& context, const RendererOptions& options, 
     // each lane's offset into a storage buffer against its size; its loads
     // and stores through a device address are faster, in the BVH walk and on
     // the ray and media stacks. Mesa 22.3 inlines its fetches and goes lane by
-    // lane through an address (docs/performance-log.md, "The BVH as a storage
+    // lane through an address (docs/log/bvh-walk.md, "The BVH as a storage
     // buffer", "The walk's floor", "The ray stack through its address").
     const bool addressesFaster = context.isLlvmpipe() && context.mesaMajor() >= 25;
     policy.bvhWords = options.readBvhWords.value_or(addressesFaster);
     policy.stacksByAddress = options.addressStacks.value_or(addressesFaster);
     // A CPU device runs a SIMD row's stores at per-lane indices lane by lane;
     // a GPU keeps such a stack in its local memory (unmeasured there: left
-    // as it was). docs/performance-log.md, "The walk's stack in registers".
+    // as it was). docs/log/bvh-walk.md, "The walk's stack in registers".
     policy.stackInRegisters = options.stackInRegisters.value_or(context.isCpuDevice()) && layout.usesBvh() &&
                               layout.bvhStackSize() <= SNELL_REGISTER_STACK_LIMIT;
     const std::uint32_t driverBudget = limitsLoopIterations(context) ? SNELL_LOOP_BUDGET_LIMITED : 0u;
@@ -53,7 +53,7 @@ KernelPolicy devicePolicy(vk::Context& context, const RendererOptions& options, 
     // size) lights at a time: worth it for SIMD rows of up to 16 lanes. On a
     // CPU device only, where a subgroup's lanes run in lockstep: a GPU's would
     // also need to meet at a subgroup barrier before they read each other's
-    // hits, and it is unmeasured there (docs/performance-log.md, "Shadow rays
+    // hits, and it is unmeasured there (docs/log/bvh-walk.md, "Shadow rays
     // shared out"). Only with snell's own walk and more than one light (one
     // shadow ray a lane has no one to share with), and where the walk cannot
     // be suspended (the shadow rays of a batch are walked in one loop).
@@ -152,7 +152,7 @@ Specialisation specialise(const Scene& scene, const GpuScene& layout, const Kern
         hasRefraction ? rayStackEntries(scene, request.trace, hasReflection) + 1 : 1;  // + the suspended ray
     // Where ray trees diverge (refraction, a BVH) a workgroup whose share of
     // the tile is taken helps with the others' (schedule/pixels.glsl, takePixel); on
-    // cheap, even scenes that cost more than it won (docs/performance-log.md, "Help with the other shares").
+    // cheap, even scenes that cost more than it won (docs/log/lane-occupancy.md, "Help with the other shares").
     values[SNELL_SPEC_HELPS] = hasRefraction || layout.usesBvh();
     // Under a tolerance, a frontier for the rays a step leaves under its
     // cut-off; where it is full, rays are traced down to the floor instead.

@@ -16,7 +16,7 @@ namespace {
 // 212 with a million (every pixel of the tile its own), tir 78 and 344.
 // 2^18 fills an H200 (132 multiprocessors of 2048 threads). (Where it
 // lost: scenes/glass 20.7 → 38.2 ms with 13 000 → 210 000;
-// docs/performance-log.md, "On a real GPU: an NVIDIA H200".)
+// docs/log/real-gpu.md, "On a real GPU: an NVIDIA H200".)
 constexpr VkDeviceSize kStackBudget = 64ull << 20;
 constexpr VkDeviceSize kGpuStackBudget = 1ull << 30;
 constexpr VkDeviceSize kGpuInvocations = 1ull << 18;

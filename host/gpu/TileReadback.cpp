@@ -125,7 +125,7 @@ void combineSamples(RetracedPixel& p, const OutputPixel& out, const FlaggedSampl
 
 // Pixels whose trees traced more rays than this are not handed to the CPU
 // reference, whose time a ray is several of the kernel's: their bound is
-// widened instead (docs/accuracy.md, "Decisions"). Nor are pixels that state
+// widened instead (docs/decisions.md). Nor are pixels that state
 // an estimate, not a bound: the reference would only estimate them again.
 constexpr std::uint32_t kRetraceRays = 1024;
 

@@ -1,7 +1,7 @@
 // An ImageWriter that may encode on a thread of its own: then compressing
 // the rows (PNG's deflate, EXR's PIZ) overlaps the render that produces them
 // instead of following it. Worth it only where the render leaves a core free
-// or the encoding is dear (docs/performance-log.md, "Writing images"); until
+// or the encoding is dear (docs/log/writing-images.md, "Writing images"); until
 // start() the rows are written at once, on the caller's thread.
 #pragma once
 

@@ -50,7 +50,7 @@ struct ImagePlacement {
 };
 
 // How EXR scan lines are compressed; every choice is lossless. Measured on
-// 8192² renders (docs/performance-log.md, "Writing images"): PIZ is the fastest
+// 8192² renders (docs/log/writing-images.md, "Writing images"): PIZ is the fastest
 // that compresses a detailed render (RLE leaves one whole; ZIP takes 1.7x as
 // long for a file 5 % smaller); RLE is 2x faster on flat images, none faster
 // still where the disk is fast.

@@ -47,7 +47,7 @@ struct Rivalry {
         }
     }
     // Boxes entered beyond this hold no rival within the margins: twice the
-    // best's margin stands for a rival's own (docs/accuracy.md says where that
+    // best's margin stands for a rival's own (docs/decisions.md says where that
     // is not enough).
     double cull() const { return best.t + 2.0 * best.margin; }
     CpuRenderer::Closest finish() {

@@ -3,7 +3,7 @@
 // translates the SPIR-V to NIR and optimises it before it finds the machine
 // code in Mesa's cache: 40 of bench/simple's 46 ms. A shader object made from
 // the binary the driver gave out last time skips that (5 ms), and the kernel
-// is the same code (docs/performance-log.md, "Start-up").
+// is the same code (docs/log/targets.md, "Start-up").
 #pragma once
 
 #include <array>

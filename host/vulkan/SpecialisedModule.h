@@ -3,7 +3,7 @@
 // SPIR-V at every pipeline creation, inlining code that the constants disable
 // before it finds that code dead; fixing the constants and removing that code
 // first (SPIRV-Tools' optimizer) took 14–21 ms off lavapipe's 53–81 ms of
-// pipeline creation (docs/performance-log.md, "Against the targets"). The folding costs
+// pipeline creation (docs/log/targets.md, "Against the targets"). The folding costs
 // about 40 ms itself, so it pays only when kept: it is done once per module
 // and specialisation and read back from a cache directory after that.
 #pragma once

@@ -40,7 +40,7 @@ uint sharedSlot(uint lane) { return gl_SubgroupID * gl_SubgroupSize + lane; }
 // of the n lanes still in the pixel loop, each walking its rays one after
 // another in one loop. No lane talks to another inside the walk (rays handed
 // out there to whichever lanes were idle, by ballots and shuffles, cost more
-// than they saved on lavapipe; docs/performance-log.md, "Lanes refilled as their walks end"): a lane reads the hit of
+// than they saved on lavapipe; docs/log/kernel-profiled.md, "Lanes refilled as their walks end"): a lane reads the hit of
 // the ray's owner from workgroup memory, and after the walk one reduction tells
 // each owner, by the same bits, which of its rays were blocked. It adds each
 // seen light's term in light order: the same sums as shadeLight's loop. The

@@ -17,7 +17,7 @@
 // tile a core. (lavapipe runs a workgroup to its end on one thread: a
 // workgroup goes on through the shares of those queued behind it, which
 // then find them taken.) Elsewhere it stops: on gonzalez-originalTest,
-// cheap and even, helping cost 15–21 % (docs/performance-log.md, "Help with the other shares"). The host
+// cheap and even, helping cost 15–21 % (docs/log/lane-occupancy.md, "Help with the other shares"). The host
 // decides (ComputeRenderer::specialise) and reads the tile's progress by it.
 layout(constant_id = SNELL_SPEC_HELPS) const bool HELPS = false;
 uint takeFromHelpedShare() {

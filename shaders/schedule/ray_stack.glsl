@@ -35,7 +35,7 @@ uint frontierEntry(uint slot, uint k) { return (RAY_STACK + k % max(FRONTIER, 1u
 // at per-lane indices: Mesa 25's lavapipe checks each lane's offset into a
 // storage buffer against its size, where through an address a load is one
 // masked gather a component, and the stack's traffic measured 1.05–1.25×
-// faster; Mesa 22.3 goes lane by lane there (docs/performance-log.md, "The ray
+// faster; Mesa 22.3 goes lane by lane there (docs/log/kernel-profiled.md, "The ray
 // stack through its address"). Without the buffer's checks an entry past the
 // end would not be dropped: followChildren keeps within RAY_STACK (stackFull).
 layout(constant_id = SNELL_SPEC_STACKS_BY_ADDRESS) const bool STACKS_BY_ADDRESS = false;
