@@ -7,8 +7,8 @@ Outside fenced code blocks, a backticked span is checked when it is
 * a repository path: its first folder is one of the repository's (or it
   starts with ../shared/, resolved against SOURCE's parent), and it names a
   file (its last part has an extension), a folder (it ends in /) or a
-  pattern (a * or a <placeholder>): the file or folder must exist, the
-  pattern match something.
+  pattern (a * or a <name> part, as in scenes/<name>.scn): the file or
+  folder must exist, the pattern match something.
   Scene names without .scn (`bench/glass`) are not paths;
 * a source file by its bare name (`ShaderObject.h`, `trace.comp`): some file
   of the repository must have that name;
